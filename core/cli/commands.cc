@@ -1,0 +1,130 @@
+#include "core/cli/commands.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "core/pipeline/graph.h"
+#include "core/pipeline/plugin_abi.h"
+#include "core/pipeline/plugin_loader.h"
+#include "core/pipeline/runner.h"
+#include "core/runtime/blas.h"
+#include "core/util/log.h"
+#include "core/version.h"
+
+namespace bimart::cli {
+
+namespace {
+
+// Reads the pipeline, applies overrides, loads the libraries it names, validates it.
+Graph load_graph(const PipelineArgs& args) {
+  GraphFile file = GraphFile::load(args.pipeline);
+  for (const auto& o : args.overrides) file.apply_override(o);
+  if (args.seed >= 0) file.seed = static_cast<std::uint64_t>(args.seed);
+  for (const auto& [lib, where] : file.plugins) {
+    try {
+      PluginLoader::global().load(lib);
+    } catch (const Error& e) {
+      throw Error(where, e.message());
+    }
+  }
+  return validate(file, Registry::global());
+}
+
+}  // namespace
+
+std::string version_text() {
+  return fmt::format("bimart {} (libtorch {}, plug-in ABI {})\n{}", BIMART_VERSION_STRING,
+                     BIMART_TORCH_VERSION, BIMART_PLUGIN_ABI_VERSION,
+                     runtime::describe(runtime::blas_info()));
+}
+
+void load_plugins(const std::vector<std::string>& extra) {
+  PluginLoader& loader = PluginLoader::global();
+  loader.load_startup();
+  for (const auto& lib : extra) loader.load(lib);
+  if (Registry::global().size() == 0)
+    log::warn("no stages registered: no plug-ins found in {} (set BIMART_PLUGIN_PATH?)", builtin_plugin_dir());
+}
+
+int run(const PipelineArgs& args) {
+  const Graph g = load_graph(args);
+  log::info("pipeline '{}': {} stages, seed {}", g.name, g.nodes.size(), g.seed);
+  RunOptions options;
+  options.on_stage = [](const GraphNode& n, std::size_t i, std::size_t count) {
+    log::info("[{}/{}] {} ({})", i + 1, count, n.id, n.entry->spec.key);
+  };
+  const RunResult result = run_graph(g, options);
+  double total = 0;
+  for (const auto& t : result.timings) total += t.seconds;
+  for (const auto& n : g.nodes)
+    if (const PortSpec* p = n.entry->spec.find_output("path"); p && p->type == type_name<std::string>())
+      std::cout << "wrote " << result.context.get<std::string>(n.id + ".path") << "\n";
+  log::info("done in {:.2f} s", total);
+  return 0;
+}
+
+int graph(const PipelineArgs& args, bool mermaid) {
+  const Graph g = load_graph(args);
+  std::cout << (mermaid ? g.mermaid() : g.describe());
+  return 0;
+}
+
+int plugins(const std::string& kind, bool json) {
+  nlohmann::json all = nlohmann::json::array();
+  int shown = 0;
+  for (const StageEntry* e : Registry::global().entries()) {
+    const StageSpec& s = e->spec;
+    if (!kind.empty() && s.kind() != kind) continue;
+    ++shown;
+    if (json) {
+      nlohmann::json j{{"key", s.key}, {"kind", s.kind()}, {"name", s.name()}, {"help", s.help},
+                       {"library", e->library}};
+      for (const auto& p : s.params)
+        j["params"].push_back({{"name", p.name}, {"type", to_string(p.type)},
+                               {"default", to_yaml(p.default_value)}, {"help", p.help}});
+      for (const auto* ports : {&s.inputs, &s.outputs})
+        for (const auto& p : *ports)
+          j[ports == &s.inputs ? "inputs" : "outputs"].push_back(
+              {{"name", p.name}, {"type", p.type}, {"optional", p.optional}, {"help", p.help}});
+      all.push_back(j);
+      continue;
+    }
+    std::cout << s.key << "  (kind " << s.kind() << ")  " << s.help << "\n";
+    std::cout << "    library: " << e->library << "\n";
+    for (const auto& p : s.params)
+      std::cout << fmt::format("    param  {:<14} {:<11} = {:<16} {}\n", p.name, to_string(p.type),
+                               to_yaml(p.default_value), p.help);
+    for (const auto& p : s.inputs)
+      std::cout << fmt::format("    in     {:<14} {}{}: {}\n", p.name, p.type, p.optional ? " (optional)" : "",
+                               p.help);
+    for (const auto& p : s.outputs) std::cout << fmt::format("    out    {:<14} {}: {}\n", p.name, p.type, p.help);
+    std::cout << "\n";
+  }
+  if (json) std::cout << all.dump(2) << "\n";
+  if (shown == 0 && !kind.empty()) {
+    log::error("no stage of kind '{}' is registered", kind);
+    return 1;
+  }
+  return 0;
+}
+
+int info() {
+  std::cout << version_text() << "\n";
+  std::cout << "built-in plug-ins: " << builtin_plugin_dir() << "\n";
+  for (const auto& lib : PluginLoader::global().libraries())
+    std::cout << "  " << lib.path << " (" << lib.stages.size() << " stages)\n";
+  return 0;
+}
+
+int bench_blas(int size, int repeats) {
+  const runtime::BlasInfo b = runtime::blas_info();
+  std::cout << runtime::describe(b) << "\n";
+  const runtime::MatmulBench r = runtime::bench_matmul(size, repeats);
+  std::cout << fmt::format("matmul {0}x{0} float32, {1} repeats: median {2:.4f} s, max {3:.4f} s, {4:.1f} GFLOP/s\n",
+                           r.n, r.repeats, r.seconds_median, r.seconds_max, r.gflops_median);
+  return 0;
+}
+
+}  // namespace bimart::cli

@@ -1,0 +1,41 @@
+// Readable names for the C++ types that travel through the context and stage ports.
+// Ports are matched by these names at graph validation, so they must be the same in every
+// library: common types get a short name here, every other type its demangled C++ name.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <typeinfo>
+#include <vector>
+
+#include "core/util/text.h"
+
+namespace bimart {
+
+template <class T>
+struct TypeName {
+  static std::string get() { return demangle(typeid(T).name()); }
+};
+
+#define BIMART_SHORT_TYPE_NAME(Type, Name) \
+  template <>                              \
+  struct TypeName<Type> {                  \
+    static std::string get() { return Name; } \
+  };
+
+BIMART_SHORT_TYPE_NAME(bool, "bool")
+BIMART_SHORT_TYPE_NAME(std::int64_t, "int")
+BIMART_SHORT_TYPE_NAME(double, "float")
+BIMART_SHORT_TYPE_NAME(std::string, "string")
+BIMART_SHORT_TYPE_NAME(std::vector<std::int64_t>, "int list")
+BIMART_SHORT_TYPE_NAME(std::vector<double>, "float list")
+BIMART_SHORT_TYPE_NAME(std::vector<std::string>, "string list")
+
+#undef BIMART_SHORT_TYPE_NAME
+
+template <class T>
+std::string type_name() {
+  return TypeName<T>::get();
+}
+
+}  // namespace bimart

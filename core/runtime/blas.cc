@@ -1,0 +1,229 @@
+#include "core/runtime/blas.h"
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+#include <ATen/Parallel.h>
+#include <c10/core/InferenceMode.h>
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <climits>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
+#include <vector>
+
+#include "core/util/error.h"
+
+namespace bimart::runtime {
+namespace {
+
+// OpenBLAS's own entry points, looked up at run time so that any BLAS links and runs.
+using GetStringFn = char* (*)();
+using GetIntFn = int (*)();
+using SetIntFn = void (*)(int);
+
+template <typename Fn>
+Fn find_symbol(const char* name) {
+  return reinterpret_cast<Fn>(dlsym(RTLD_DEFAULT, name));
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// The file a loaded symbol lives in, with symlinks (Debian's alternatives) resolved.
+std::string library_of(void* symbol) {
+  Dl_info where{};
+  if (symbol == nullptr || dladdr(symbol, &where) == 0 || where.dli_fname == nullptr) return "";
+  char resolved[PATH_MAX];
+  if (realpath(where.dli_fname, resolved) != nullptr) return resolved;
+  return where.dli_fname;
+}
+
+const char* env(const char* name) { return std::getenv(name); }
+
+bool is_set(const char* value) { return value != nullptr && value[0] != '\0'; }
+
+}  // namespace
+
+std::string choose_openblas_coretype() {
+#if defined(__x86_64__) || defined(__i386__)
+  // __builtin_cpu_supports also checks that the OS saves the AVX / AVX-512 registers.
+  __builtin_cpu_init();
+  const bool avx = __builtin_cpu_supports("avx");
+  const bool avx2_fma = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+  if (avx512 && avx2_fma) return "SkylakeX";
+  // OpenBLAS's Zen kernel is its Haswell code with AMD's cache sizes.
+  if (avx2_fma) return __builtin_cpu_is("amd") ? "Zen" : "Haswell";
+  if (avx) return "Sandybridge";
+#endif
+  return "";
+}
+
+std::string reexec_coretype(const std::function<const char*(const char*)>& getenv,
+                            bool openblas_loaded, const std::string& chosen,
+                            const std::string& loaded_core) {
+  if (is_set(getenv(kCoretypeEnv))) return "";  // the user's own choice wins
+  if (const char* opt = getenv(kReexecEnv); opt != nullptr) {
+    const std::string v = lower(opt);
+    if (v == "0" || v == "false" || v == "off" || v == "no") return "";
+  }
+  if (is_set(getenv(kReexecGuardEnv))) return "";  // this process is the re-executed one
+  if (!openblas_loaded || chosen.empty()) return "";
+  if (!loaded_core.empty() && lower(loaded_core) == lower(chosen)) return "";
+  return chosen;
+}
+
+void ensure_blas_kernel(int argc, char** argv) {
+  const auto corename = find_symbol<GetStringFn>("openblas_get_corename");
+  const char* loaded = corename != nullptr ? corename() : nullptr;
+  const std::string value = reexec_coretype(env, corename != nullptr, choose_openblas_coretype(),
+                                            loaded != nullptr ? loaded : "");
+  if (value.empty()) return;
+
+  // /proc/self/exe is ld.so itself when the program was started as `ld.so ./bimart`;
+  // re-executing that with our argv would not run bimart.
+  char self[PATH_MAX];
+  const ssize_t len = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (len <= 0) return;
+  self[len] = '\0';
+  if (std::strstr(self, "/ld-linux") != nullptr) return;
+
+  std::vector<char*> args;
+  for (int i = 0; argv != nullptr && i < argc; ++i) args.push_back(argv[i]);
+  static char fallback_name[] = "bimart";
+  if (args.empty()) args.push_back(fallback_name);
+  args.push_back(nullptr);
+
+  setenv(kCoretypeEnv, value.c_str(), 1);
+  setenv(kReexecGuardEnv, value.c_str(), 1);
+  std::fflush(nullptr);  // anything already printed must not be lost or printed twice
+  execv("/proc/self/exe", args.data());
+
+  // Still here: exec failed. Undo, so children and blas_info() see the truth.
+  const int err = errno;
+  unsetenv(kCoretypeEnv);
+  unsetenv(kReexecGuardEnv);
+  std::fprintf(stderr,
+               "bimart: note: could not restart with %s=%s (%s); continuing with OpenBLAS's "
+               "'%s' kernel\n",
+               kCoretypeEnv, value.c_str(), std::strerror(err), loaded != nullptr ? loaded : "?");
+}
+
+BlasInfo blas_info() {
+  BlasInfo info;
+  const auto config = find_symbol<GetStringFn>("openblas_get_config");
+  const auto corename = find_symbol<GetStringFn>("openblas_get_corename");
+  const auto num_threads = find_symbol<GetIntFn>("openblas_get_num_threads");
+  if (config != nullptr) {
+    info.library = library_of(reinterpret_cast<void*>(config));
+    if (info.library.empty()) info.library = "OpenBLAS (file unknown)";
+    if (const char* c = config()) info.config = c;
+  } else {
+    info.library = "unknown (not OpenBLAS)";
+  }
+  if (corename != nullptr) {
+    if (const char* c = corename()) info.core = c;
+  }
+  if (num_threads != nullptr) info.blas_threads = num_threads();
+  info.sgemm_library = library_of(dlsym(RTLD_DEFAULT, "sgemm_"));
+  info.chosen_core = choose_openblas_coretype();
+
+  info.torch_threads = at::get_num_threads();
+  info.torch_interop_threads = at::get_num_interop_threads();
+
+  const char* coretype = env(kCoretypeEnv);
+  const char* guard = env(kReexecGuardEnv);
+  if (!is_set(coretype)) {
+    info.coretype_source = "not set";
+  } else if (is_set(guard) && std::strcmp(guard, coretype) == 0) {
+    info.coretype_source = "chosen by bimart";
+  } else {
+    info.coretype_source = "set by user";
+  }
+  return info;
+}
+
+std::string describe(const BlasInfo& info) {
+  std::string s;
+  if (!info.config.empty()) {
+    s += "BLAS:    " + info.config + "\n";
+    s += "         " + info.library + "\n";
+  } else {
+    s += "BLAS:    " + info.library + "\n";
+  }
+  if (!info.sgemm_library.empty() && info.sgemm_library != info.library) {
+    s += "sgemm_:  " + info.sgemm_library + "\n";
+  }
+  if (!info.core.empty()) {
+    const char* value = env(kCoretypeEnv);
+    std::string how = "OPENBLAS_CORETYPE " + info.coretype_source;
+    if (is_set(value)) how += " (" + std::string(value) + ")";
+    s += "kernel:  " + info.core + " (" + how + ")\n";
+    if (!info.chosen_core.empty() && lower(info.core) != lower(info.chosen_core)) {
+      s += "note:    this CPU can run OpenBLAS's '" + info.chosen_core +
+           "' kernel; unset OPENBLAS_CORETYPE and BIMART_BLAS_REEXEC to let bimart pick it\n";
+    }
+  }
+  s += "threads: " + std::to_string(info.torch_threads) + " intra-op, " +
+       std::to_string(info.torch_interop_threads) + " inter-op";
+  if (info.blas_threads > 0) s += ", " + std::to_string(info.blas_threads) + " BLAS";
+  s += "\n";
+  return s;
+}
+
+void set_threads(int n) {
+  if (n <= 0) n = static_cast<int>(std::thread::hardware_concurrency());
+  if (n <= 0) n = 1;  // hardware_concurrency() may not know
+  at::set_num_threads(n);  // also omp_set_num_threads
+  // OpenBLAS's OpenMP build follows OpenMP upward only once it left 1 thread: tell it too.
+  if (const auto set = find_symbol<SetIntFn>("openblas_set_num_threads")) set(n);
+}
+
+MatmulBench bench_matmul(int n, int repeats) {
+  if (n <= 0) throw Error("matmul benchmark: size must be positive, got " + std::to_string(n));
+  if (repeats <= 0) {
+    throw Error("matmul benchmark: repeats must be positive, got " + std::to_string(repeats));
+  }
+  c10::InferenceMode no_autograd;
+  auto gen = at::detail::createCPUGenerator(/*seed_val=*/12345);
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  const at::Tensor a = at::randn({n, n}, gen, opts);
+  const at::Tensor b = at::randn({n, n}, gen, opts);
+  at::Tensor c = at::empty({n, n}, opts);
+
+  at::mm_out(c, a, b);  // warm-up: thread pool start, page faults, BLAS buffers
+  std::vector<double> seconds;
+  seconds.reserve(static_cast<std::size_t>(repeats));
+  for (int i = 0; i < repeats; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    at::mm_out(c, a, b);
+    const auto t1 = std::chrono::steady_clock::now();
+    seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+  }
+  std::sort(seconds.begin(), seconds.end());
+  const std::size_t mid = seconds.size() / 2;
+  const double median =
+      seconds.size() % 2 == 1 ? seconds[mid] : 0.5 * (seconds[mid - 1] + seconds[mid]);
+
+  MatmulBench r;
+  r.n = n;
+  r.repeats = repeats;
+  r.seconds_median = median;
+  r.seconds_max = seconds.back();
+  const double flops = 2.0 * static_cast<double>(n) * n * n;
+  r.gflops_median = median > 0 ? flops / median / 1e9 : 0.0;
+  return r;
+}
+
+}  // namespace bimart::runtime

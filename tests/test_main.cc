@@ -1,0 +1,9 @@
+#include <gtest/gtest.h>
+
+#include "core/runtime/blas.h"
+
+int main(int argc, char** argv) {
+  bimart::runtime::ensure_blas_kernel(argc, argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
