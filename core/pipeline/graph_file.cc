@@ -2,7 +2,6 @@
 // item. What the names mean is checked in graph_validate.cc.
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include "core/pipeline/graph.h"
@@ -58,8 +57,7 @@ StageSetting read_stage(const Reader& r, const YAML::Node& node, std::size_t ind
   if (!node["id"]) r.fail(node, where + " has no 'id'");
   if (!node["use"]) r.fail(node, where + " has no 'use' (the implementation, e.g. encoder.np_bps)");
   s.id = r.scalar(node["id"], "'id'");
-  static const std::regex id_pattern("[a-z_][a-z0-9_]*");
-  if (!std::regex_match(s.id, id_pattern))
+  if (!is_lower_identifier(s.id))
     r.fail(node["id"], "stage id '" + s.id + "' must be lower case letters, digits and '_'");
   s.use = r.scalar(node["use"], "'use'");
   s.use_where = at(r.path(), node["use"]);

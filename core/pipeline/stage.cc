@@ -1,7 +1,6 @@
 #include "core/pipeline/stage.h"
 
 #include <algorithm>
-#include <regex>
 #include <set>
 
 #include "core/util/error.h"
@@ -66,8 +65,9 @@ const PortSpec* StageSpec::find_input(const std::string& n) const { return find_
 const PortSpec* StageSpec::find_output(const std::string& n) const { return find_named(outputs, n); }
 
 void StageSpec::check() const {
-  static const std::regex key_pattern("[a-z][a-z0-9_]*\\.[a-z][a-z0-9_]*");
-  if (!std::regex_match(key, key_pattern))
+  const auto dot = key.find('.');
+  if (dot == std::string::npos || !is_lower_identifier(key.substr(0, dot), false) ||
+      !is_lower_identifier(key.substr(dot + 1), false))
     throw Error("stage key '" + key + "' is not of the form kind.name (lower case, digits, '_')");
   auto unique = [&](const auto& items, const char* what) {
     std::set<std::string> seen;

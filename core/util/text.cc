@@ -53,6 +53,14 @@ std::string did_you_mean(const std::string& wanted, const std::vector<std::strin
   return s + "?)";
 }
 
+bool is_lower_identifier(const std::string& s, bool allow_leading_underscore) {
+  if (s.empty()) return false;
+  const bool first_ok = (s[0] >= 'a' && s[0] <= 'z') || (allow_leading_underscore && s[0] == '_');
+  return first_ok && std::all_of(s.begin(), s.end(), [](char c) {
+           return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+         });
+}
+
 std::string join(const std::vector<std::string>& parts, const std::string& sep) {
   std::string s;
   for (std::size_t i = 0; i < parts.size(); ++i) {

@@ -18,6 +18,10 @@ std::vector<std::string> closest_names(const std::string& wanted,
 // " (did you mean 'a' or 'b'?)" or "" when nothing is close.
 std::string did_you_mean(const std::string& wanted, const std::vector<std::string>& candidates);
 
+// True for [a-z_][a-z0-9_]* (stage ids) or, with allow_leading_underscore false,
+// [a-z][a-z0-9_]* (kinds and names in stage keys).
+bool is_lower_identifier(const std::string& s, bool allow_leading_underscore = true);
+
 std::string join(const std::vector<std::string>& parts, const std::string& sep);
 
 // Demangled C++ name of a type_info (falls back to the mangled name).

@@ -17,3 +17,13 @@ TEST(Text, DidYouMeanListsCloseNamesBestFirst) {
   EXPECT_EQ(did_you_mean("encoder.npbps", keys), " (did you mean 'encoder.np_bps', 'encoder.npa_bps' or 'encoder.u_bps'?)");
   EXPECT_EQ(did_you_mean("something.else", keys), "");
 }
+
+TEST(Text, LowerIdentifiers) {
+  EXPECT_TRUE(is_lower_identifier("np_bps2"));
+  EXPECT_TRUE(is_lower_identifier("_hidden"));
+  EXPECT_FALSE(is_lower_identifier("_hidden", false));
+  EXPECT_FALSE(is_lower_identifier("2fast"));
+  EXPECT_FALSE(is_lower_identifier("Upper"));
+  EXPECT_FALSE(is_lower_identifier("with-dash"));
+  EXPECT_FALSE(is_lower_identifier(""));
+}

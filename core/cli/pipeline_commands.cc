@@ -1,4 +1,6 @@
-#include "core/cli/commands.h"
+#include "core/cli/pipeline_commands.h"
+
+#include "core/cli/command.h"
 
 #include <fmt/format.h>
 
@@ -125,6 +127,44 @@ int bench_blas(int size, int repeats) {
   std::cout << fmt::format("matmul {0}x{0} float32, {1} repeats: median {2:.4f} s, max {3:.4f} s, {4:.1f} GFLOP/s\n",
                            r.n, r.repeats, r.seconds_median, r.seconds_max, r.gflops_median);
   return 0;
+}
+
+void add_pipeline_commands(CLI::App& app, Commands& out) {
+  // Options of run and graph share one struct: only one sub-command runs per call.
+  static PipelineArgs pa;
+  auto add_pipeline_args = [&](CLI::App* cmd) {
+    cmd->add_option("pipeline", pa.pipeline, "pipeline YAML file")->required()->check(CLI::ExistingFile);
+    cmd->add_option("--set", pa.overrides, "override a parameter: stage.param=value (repeatable)");
+    cmd->add_option("--seed", pa.seed, "override the pipeline's seed")->check(CLI::NonNegativeNumber);
+  };
+
+  CLI::App* run_cmd = app.add_subcommand("run", "run a pipeline");
+  add_pipeline_args(run_cmd);
+  out.push_back({run_cmd, [] { return run(pa); }});
+
+  static bool mermaid = false;
+  CLI::App* graph_cmd = app.add_subcommand("graph", "validate a pipeline and print its stage graph");
+  add_pipeline_args(graph_cmd);
+  graph_cmd->add_flag("--mermaid", mermaid, "print a mermaid flowchart instead");
+  out.push_back({graph_cmd, [] { return graph(pa, mermaid); }});
+
+  static std::string kind;
+  static bool json = false;
+  CLI::App* plugins_cmd = app.add_subcommand("plugins", "list every registered stage with its parameters");
+  plugins_cmd->add_option("--kind", kind, "only stages of this kind (e.g. encoder)");
+  plugins_cmd->add_flag("--json", json, "machine-readable output");
+  out.push_back({plugins_cmd, [] { return plugins(kind, json); }});
+
+  CLI::App* info_cmd = app.add_subcommand("info", "version, BLAS library and kernel, threads, plug-in folders");
+  out.push_back({info_cmd, [] { return info(); }});
+
+  static int size = 2048, repeats = 10;
+  CLI::App* bench = app.add_subcommand("bench", "benchmarks");
+  bench->require_subcommand(1);
+  CLI::App* blas = bench->add_subcommand("blas", "float32 matrix product through libtorch: GFLOP/s");
+  blas->add_option("--size", size, "matrix size n (n x n)")->check(CLI::PositiveNumber);
+  blas->add_option("--repeats", repeats, "timed repetitions")->check(CLI::PositiveNumber);
+  out.push_back({blas, [] { return bench_blas(size, repeats); }, false});
 }
 
 }  // namespace bimart::cli

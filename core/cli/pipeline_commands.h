@@ -1,4 +1,5 @@
-// The sub-commands of `bimart`. Each returns the process exit code.
+// The pipeline sub-commands of `bimart`: run, graph, plugins, info, bench. Each returns
+// the process exit code.
 #pragma once
 
 #include <string>

@@ -1,0 +1,24 @@
+// How a sub-command plugs into `bimart`: a function that adds its CLI11 sub-command(s) and
+// returns, for each, the handler to run when it was chosen. Handlers return the exit code
+// and may throw bimart::Error (printed as an error, exit code 1).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace bimart::cli {
+
+struct Command {
+  CLI::App* app;
+  std::function<int()> run;
+  bool needs_plugins = true;  // load the plug-in libraries before running
+};
+
+using Commands = std::vector<Command>;
+
+// One per file in core/cli/: each adds its sub-commands to `app`.
+void add_pipeline_commands(CLI::App& app, Commands& out);  // run, graph, plugins, info, bench
+}  // namespace bimart::cli
