@@ -8,7 +8,9 @@ packages=(
   libtorch-dev libopenblas0-openmp        # networks; OpenMP OpenBLAS (DESIGN §8)
   libeigen3-dev libyaml-cpp-dev libcgal-dev libceres-dev
   libfmt-dev libspdlog-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
-  libtinygltf-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libtinygltf-dev libzip-dev libstb-dev             # glTF export; .npz files; PNG pictures
+  libgtest-dev libgmock-dev libbenchmark-dev
+  python3 python3-numpy                              # tools/ converters (numpy only)
 )
 
 missing=()

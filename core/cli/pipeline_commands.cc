@@ -116,7 +116,7 @@ int info() {
   std::cout << version_text() << "\n";
   std::cout << "built-in plug-ins: " << builtin_plugin_dir() << "\n";
   for (const auto& lib : PluginLoader::global().libraries())
-    std::cout << "  " << lib.path << " (" << lib.stages.size() << " stages)\n";
+    std::cout << "  " << lib.path << " (" << lib.stages.size() << (lib.stages.size() == 1 ? " stage)\n" : " stages)\n");
   return 0;
 }
 

@@ -33,7 +33,7 @@ class Problems {
 ParamValue convert(const YAML::Node& node, ParamType type) {
   auto scalar_text = [&]() -> std::string {
     if (node.IsNull()) throw std::runtime_error("has no value");
-    if (!node.IsScalar()) throw std::runtime_error("expects a " + std::string(to_string(type)) + ", got a list or mapping");
+    if (!node.IsScalar()) throw std::runtime_error("expects " + with_article(type) + ", got a list or mapping");
     return node.Scalar();
   };
   auto as = [&](const YAML::Node& n, ParamType t) -> ParamValue {
@@ -47,7 +47,7 @@ ParamValue convert(const YAML::Node& node, ParamType type) {
         default: return n.Scalar();
       }
     } catch (const YAML::Exception&) {
-      throw std::runtime_error("expects a " + std::string(to_string(t)) + ", got '" + text + "'");
+      throw std::runtime_error("expects " + with_article(t) + ", got '" + text + "'");
     }
   };
   switch (type) {
@@ -61,7 +61,7 @@ ParamValue convert(const YAML::Node& node, ParamType type) {
     case ParamType::FloatList:
     case ParamType::StringList: {
       if (!node.IsSequence())
-        throw std::runtime_error("expects a " + std::string(to_string(type)) + " like [1, 2]");
+        throw std::runtime_error("expects " + with_article(type) + " like [1, 2]");
       const ParamType item = type == ParamType::IntList     ? ParamType::Int
                              : type == ParamType::FloatList ? ParamType::Float
                                                             : ParamType::String;

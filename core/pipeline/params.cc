@@ -20,6 +20,11 @@ const char* to_string(ParamType type) {
   return "?";
 }
 
+std::string with_article(ParamType type) {
+  const std::string name = to_string(type);
+  return (name[0] == 'i' ? "an " : "a ") + name;
+}
+
 ParamType type_of(const ParamValue& value) { return static_cast<ParamType>(value.index()); }
 
 namespace {
@@ -34,9 +39,15 @@ std::string quoted(const std::string& s) {
 }
 
 std::string number_text(double x) {
+  // Shortest of 15 or 17 significant digits that reads back exactly.
   std::ostringstream os;
-  os.precision(17);
+  os.precision(15);
   os << x;
+  if (std::stod(os.str()) != x) {
+    os.str("");
+    os.precision(17);
+    os << x;
+  }
   std::string s = os.str();
   // Keep floats recognisable as floats in YAML ("1" would read back as an int).
   if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
@@ -83,8 +94,8 @@ template <class T>
 const T& Params::typed(const std::string& name) const {
   const ParamValue& v = value(name);
   if (const T* x = std::get_if<T>(&v)) return *x;
-  throw Error("parameter '" + name + "' is a " + to_string(type_of(v)) + ", but was read as a " +
-              to_string(type_of(ParamValue(T{}))));
+  throw Error("parameter '" + name + "' is " + with_article(type_of(v)) + ", but was read as " +
+              with_article(type_of(ParamValue(T{}))));
 }
 
 bool Params::boolean(const std::string& name) const { return typed<bool>(name); }

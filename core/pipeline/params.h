@@ -13,6 +13,8 @@ enum class ParamType { Bool, Int, Float, String, IntList, FloatList, StringList 
 
 // "bool", "int", "float", "string", "int list", "float list", "string list".
 const char* to_string(ParamType type);
+// "a float", "an int", ...
+std::string with_article(ParamType type);
 
 using ParamValue = std::variant<bool, std::int64_t, double, std::string, std::vector<std::int64_t>,
                                 std::vector<double>, std::vector<std::string>>;

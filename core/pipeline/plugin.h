@@ -35,14 +35,16 @@ namespace plugin_detail {
 using SpecFn = StageSpec (*)();
 
 // Records a stage class in this library's local list (defined in plugin_entry.cc, which
-// every plug-in library links statically); returns true.
-bool add_local_stage(SpecFn spec, StageFactory factory);
+// every plug-in library links statically), with the identity of the code that registered
+// it; returns true.
+bool add_local_stage(SpecFn spec, StageFactory factory, const BimartPluginInfo* identity);
 
 template <class T>
 bool register_local() {
-  return add_local_stage(&T::spec, [](const Params& p) -> std::unique_ptr<Stage> {
-    return std::make_unique<T>(p);
-  });
+  static const BimartPluginInfo identity = BIMART_THIS_BUILD_INFO;  // this plug-in's compiler
+  return add_local_stage(
+      &T::spec, [](const Params& p) -> std::unique_ptr<Stage> { return std::make_unique<T>(p); },
+      &identity);
 }
 
 }  // namespace plugin_detail

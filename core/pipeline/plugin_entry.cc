@@ -9,6 +9,7 @@ namespace {
 struct LocalStage {
   SpecFn spec;
   StageFactory factory;
+  const BimartPluginInfo* identity;
 };
 
 std::vector<LocalStage>& local_stages() {
@@ -18,8 +19,8 @@ std::vector<LocalStage>& local_stages() {
 
 }  // namespace
 
-bool add_local_stage(SpecFn spec, StageFactory factory) {
-  local_stages().push_back({spec, std::move(factory)});
+bool add_local_stage(SpecFn spec, StageFactory factory, const BimartPluginInfo* identity) {
+  local_stages().push_back({spec, std::move(factory), identity});
   return true;
 }
 
@@ -27,12 +28,12 @@ bool add_local_stage(SpecFn spec, StageFactory factory) {
 
 extern "C" {
 
+// The identity recorded by the library's first registration (its own sources); a library
+// without stages reports this file's.
 __attribute__((visibility("default"))) const BimartPluginInfo* bimart_plugin_info() {
-  static const BimartPluginInfo info = {
-      sizeof(BimartPluginInfo), alignof(BimartPluginInfo), BIMART_PLUGIN_ABI_VERSION,
-      BIMART_VERSION_STRING,    BIMART_COMPILER_ID,        BIMART_TORCH_VERSION,
-      BIMART_CXX11_ABI};
-  return &info;
+  static const BimartPluginInfo own = BIMART_THIS_BUILD_INFO;
+  const auto& stages = bimart::plugin_detail::local_stages();
+  return stages.empty() ? &own : stages.front().identity;
 }
 
 __attribute__((visibility("default"))) void bimart_plugin_register(bimart::PluginRegistrar* r) {

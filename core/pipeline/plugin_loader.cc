@@ -96,8 +96,10 @@ void PluginLoader::load_directory(const std::string& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return;
   std::vector<std::string> files;
-  for (const auto& f : fs::directory_iterator(dir))
-    if (f.is_regular_file() && f.path().extension() == ".so") files.push_back(f.path().string());
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().extension() == ".so" && fs::is_regular_file(it->path(), ec))
+      files.push_back(it->path().string());
+  if (ec) throw Error("cannot read plug-in folder " + dir + ": " + ec.message());
   std::sort(files.begin(), files.end());
   for (const auto& f : files) load(f);
 }
@@ -122,7 +124,9 @@ std::string builtin_plugin_dir() {
   Dl_info info{};
   if (dladdr(reinterpret_cast<void*>(&builtin_plugin_dir), &info) == 0 || info.dli_fname == nullptr)
     return "";
-  return (fs::path(info.dli_fname).parent_path() / "bimart" / "plugins").string();
+  std::error_code ec;
+  const fs::path lib = fs::weakly_canonical(info.dli_fname, ec);
+  return ((ec ? fs::path(info.dli_fname) : lib).parent_path() / "bimart" / "plugins").string();
 }
 
 }  // namespace bimart

@@ -24,6 +24,10 @@ struct TypeName {
   };
 
 BIMART_SHORT_TYPE_NAME(bool, "bool")
+// Ports and parameters use int64 ("int") and double ("float"); the narrower C++ types get
+// names of their own so that a mix-up is caught at validation, not when the value is read.
+BIMART_SHORT_TYPE_NAME(int, "int32")
+BIMART_SHORT_TYPE_NAME(float, "float32")
 BIMART_SHORT_TYPE_NAME(std::int64_t, "int")
 BIMART_SHORT_TYPE_NAME(double, "float")
 BIMART_SHORT_TYPE_NAME(std::string, "string")

@@ -61,3 +61,15 @@ TEST(Context, PutReplaces) {
   EXPECT_EQ(c.type_of("k"), "string");
   EXPECT_EQ(c.size(), 1u);
 }
+
+TEST(Context, NarrowTypesHaveTheirOwnNames) {
+  // int vs int64 and float vs double must not share a name, or validation would pass a
+  // port that fails when read.
+  EXPECT_EQ(bimart::type_name<std::int64_t>(), "int");
+  EXPECT_EQ(bimart::type_name<int>(), "int32");
+  EXPECT_EQ(bimart::type_name<double>(), "float");
+  EXPECT_EQ(bimart::type_name<float>(), "float32");
+  Context c;
+  c.put("a.n", 3);
+  EXPECT_THROW(c.get<std::int64_t>("a.n"), Error);
+}

@@ -95,7 +95,7 @@ TEST(Graph, MistypedParameterPointsAtTheValue) {
       count: 2.5
 )");
   EXPECT_HAS(m, "test.yaml:5:14:");
-  EXPECT_HAS(m, "parameter 'count' expects a int, got '2.5'");
+  EXPECT_HAS(m, "parameter 'count' expects an int, got '2.5'");
   const std::string list = error_of(R"(stages:
   - id: src
     use: test.source
@@ -280,7 +280,7 @@ TEST(Graph, OverridesReplaceAndAddParameters) {
 
 TEST(Graph, OverrideErrorsNameTheOverride) {
   EXPECT_HAS(error_of(kGood, {"src.valeu=9"}), "--set src.valeu=9: stage 'src' (test.source) has no parameter 'valeu'");
-  EXPECT_HAS(error_of(kGood, {"src.count=abc"}), "--set src.count=abc: stage 'src' parameter 'count' expects a int, got 'abc'");
+  EXPECT_HAS(error_of(kGood, {"src.count=abc"}), "--set src.count=abc: stage 'src' parameter 'count' expects an int, got 'abc'");
   EXPECT_HAS(error_of(kGood, {"scr.value=1"}), "no stage 'scr'");
   EXPECT_HAS(error_of(kGood, {"value=1"}), "names no stage parameter");
   EXPECT_HAS(error_of(kGood, {"seed=x"}), "seed must be a non-negative integer");

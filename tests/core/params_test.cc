@@ -22,6 +22,8 @@ TEST(Params, YamlTextOfValues) {
   EXPECT_EQ(to_yaml(ParamValue(std::int64_t{64})), "64");
   EXPECT_EQ(to_yaml(ParamValue(1.0)), "1.0");
   EXPECT_EQ(to_yaml(ParamValue(0.25)), "0.25");
+  EXPECT_EQ(to_yaml(ParamValue(0.3)), "0.3");                       // not 0.29999999999999999
+  EXPECT_EQ(to_yaml(ParamValue(0.1 + 0.2)), "0.30000000000000004");  // exact when needed
   EXPECT_EQ(to_yaml(ParamValue(std::string("a\"b"))), "\"a\\\"b\"");
   EXPECT_EQ(to_yaml(ParamValue(std::vector<double>{1, 2.5})), "[1.0, 2.5]");
 }
@@ -30,7 +32,12 @@ TEST(Params, TypedAccessAndErrors) {
   Params p;
   p.set("frames", std::int64_t{64});
   EXPECT_EQ(p.integer("frames"), 64);
-  EXPECT_THROW(p.number("frames"), Error);
+  try {
+    p.number("frames");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "parameter 'frames' is an int, but was read as a float");
+  }
   try {
     p.integer("frame");
     FAIL();

@@ -73,6 +73,13 @@ TEST(PluginLoader, RefusesAnotherCompiler) {
   EXPECT_HAS(m, "rebuild the plug-in");
 }
 
+TEST(PluginLoader, CompilerIdentityComesFromThePluginsOwnSources) {
+  Registry r;
+  EXPECT_HAS(refusal(test_lib("test_other_compiler"), r), "was built with compiler 'clang 99.0'");
+  PluginLoader loader(r);
+  EXPECT_NO_THROW(loader.load(test_lib("test_random")));  // same source, this compiler
+}
+
 TEST(PluginLoader, RefusesAnotherLibtorch) {
   Registry r;
   EXPECT_HAS(refusal(test_lib("test_bad_torch"), r), "libtorch 0.4.1");
