@@ -15,6 +15,7 @@ endforeach()
 install(FILES ${PROJECT_BINARY_DIR}/include/bimart/core/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bimart/core)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/pipelines/ DESTINATION ${CMAKE_INSTALL_DATADIR}/bimart/pipelines)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/models/ DESTINATION ${CMAKE_INSTALL_DATADIR}/bimart/models)
 
 set(config_dir ${CMAKE_INSTALL_LIBDIR}/cmake/bimart)
 install(EXPORT bimartTargets NAMESPACE bimart:: DESTINATION ${config_dir})

@@ -21,4 +21,7 @@ using Commands = std::vector<Command>;
 
 // One per file in core/cli/: each adds its sub-commands to `app`.
 void add_pipeline_commands(CLI::App& app, Commands& out);  // run, graph, plugins, info, bench
+void add_bps_commands(CLI::App& app, Commands& out);       // bps make
+void add_object_commands(CLI::App& app, Commands& out);    // object make, list, info, gallery
+void add_hand_commands(CLI::App& app, Commands& out);      // hand make
 }  // namespace bimart::cli

@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
 
   bimart::cli::Commands commands;
   bimart::cli::add_pipeline_commands(app, commands);
+  bimart::cli::add_bps_commands(app, commands);
+  bimart::cli::add_object_commands(app, commands);
+  bimart::cli::add_hand_commands(app, commands);
 
   bimart::runtime::set_threads(0);  // all cores, also for what --version reports
   CLI11_PARSE(app, argc, argv);

@@ -414,6 +414,14 @@ NpzFile NpzFile::read(const std::string& path) {
 }
 
 void NpzFile::write(const std::string& path, NpzCompression compression) const {
+  if (arrays_.empty()) {
+    // libzip writes nothing for an empty archive; numpy writes the 22-byte end record.
+    write_file_atomically(path, [](std::ostream& out) {
+      const char end_record[22] = {0x50, 0x4b, 0x05, 0x06};
+      out.write(end_record, sizeof(end_record));
+    });
+    return;
+  }
   // Serialised members must outlive zip_close(), which reads them.
   std::vector<std::vector<uint8_t>> members;
   members.reserve(arrays_.size());

@@ -57,17 +57,21 @@ std::string npy_dtype() {
 template <class T>
 NpyArray make_npy(const T* values, std::vector<int64_t> shape) {
   NpyArray a{npy_dtype<T>(), std::move(shape), {}};
+  for (int64_t d : a.shape)
+    if (d < 0) throw Error("make_npy: negative extent in shape " + a.shape_str());
   a.data.resize(static_cast<size_t>(a.num_elements()) * sizeof(T));
   if (!a.data.empty()) std::memcpy(a.data.data(), values, a.data.size());
   return a;
 }
 template <class T, class = std::enable_if_t<!std::is_same_v<T, bool>>>
 NpyArray make_npy(const std::vector<T>& values, std::vector<int64_t> shape) {
-  NpyArray a = make_npy(values.data(), std::move(shape));
-  if (static_cast<size_t>(a.num_elements()) != values.size())
+  const NpyArray empty{npy_dtype<T>(), shape, {}};
+  int64_t n = 1;
+  for (int64_t d : shape) n *= d;
+  if (n < 0 || static_cast<size_t>(n) != values.size())
     throw Error("make_npy: " + std::to_string(values.size()) + " values do not fill shape " +
-                a.shape_str());
-  return a;
+                empty.shape_str());
+  return make_npy(values.data(), std::move(shape));
 }
 // 1-D array of the vector's length.
 template <class T, class = std::enable_if_t<!std::is_same_v<T, bool>>>
@@ -85,11 +89,7 @@ NpyArray make_npy(const Eigen::DenseBase<Derived>& m, std::vector<int64_t> shape
   using T = typename Derived::Scalar;
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm = m;
   if (shape.empty()) shape = {static_cast<int64_t>(rm.rows()), static_cast<int64_t>(rm.cols())};
-  NpyArray a = make_npy(rm.data(), std::move(shape));
-  if (a.num_elements() != static_cast<int64_t>(rm.size()))
-    throw Error("make_npy: a " + std::to_string(rm.rows()) + " x " + std::to_string(rm.cols()) +
-                " matrix does not fill shape " + a.shape_str());
-  return a;
+  return make_npy(std::vector<T>(rm.data(), rm.data() + rm.size()), std::move(shape));
 }
 // Unicode strings (UTF-8 in, "U<n>" with n = the longest string's code points).
 NpyArray make_npy_strings(const std::vector<std::string>& values, std::vector<int64_t> shape);

@@ -44,7 +44,8 @@ struct RenderOptions {
 };
 
 // A camera that looks along `view_dir` (from the eye towards the scene) at the centre of
-// the items' bounding box, far enough that their bounding sphere fits the view. Its `up`
+// the items' bounding box, far enough that their bounding sphere fits the vertical field of
+// view (so the whole view when the image is at least as wide as high). Its `up`
 // is +y unless view_dir is nearly parallel to y, then -z.
 Camera frame_items(const std::vector<RenderItem>& items, const Eigen::Vector3d& view_dir, double fov_deg = 35);
 

@@ -1,0 +1,37 @@
+// Nearest-neighbour queries on a fixed 3-D point set (a k-d tree from nanoflann). Build it
+// once per rigid point set and move the queries, not the points.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+
+namespace bimart {
+
+using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+class NearestPoints {
+ public:
+  // Copies the points; at least one is required.
+  explicit NearestPoints(Points3 points);
+  ~NearestPoints();
+  NearestPoints(NearestPoints&&) noexcept;
+  NearestPoints& operator=(NearestPoints&&) noexcept;
+
+  struct Hit {
+    int index = -1;
+    double distance_sq = 0;
+  };
+
+  Hit nearest(const Eigen::Vector3d& query) const;
+  // For each row of `queries`: the nearest point's index and squared distance.
+  void nearest(const Points3& queries, int* indices, double* distances_sq) const;
+
+  const Points3& points() const;
+  Eigen::Index size() const { return points().rows(); }
+
+ private:
+  struct Tree;
+  std::unique_ptr<Tree> tree_;
+};
+
+}  // namespace bimart

@@ -1,0 +1,22 @@
+// Batched posing with libtorch: many frames of an object state at once (DESIGN §4).
+#pragma once
+
+#include <ATen/core/Tensor.h>
+
+#include "core/object/articulated_object.h"
+
+namespace bimart {
+
+struct PosedObjectBatch {
+  at::Tensor top;     // [N, Vt, 3] world frame
+  at::Tensor bottom;  // [N, Vb, 3] world frame
+};
+
+// `states` is [N, 7] (float32 or float64; the output has the same dtype):
+// [angle, rx, ry, rz, tx, ty, tz]. Throws bimart::Error on a wrong shape or a non-finite value.
+PosedObjectBatch pose_object_batch(const ArticulatedObject& object, const at::Tensor& states);
+
+// Batched Rodrigues: [N, 3] axis-angle -> [N, 3, 3], robust at zero angle.
+at::Tensor axis_angle_to_matrix_batch(const at::Tensor& axis_angle);
+
+}  // namespace bimart
