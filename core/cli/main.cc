@@ -5,6 +5,7 @@
 
 #include "core/cli/command.h"
 #include "core/cli/pipeline_commands.h"
+#include "core/runtime/allocator.h"
 #include "core/runtime/blas.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -12,6 +13,7 @@
 int main(int argc, char** argv) {
   // May re-execute the program once with the right OpenBLAS kernel (DESIGN §8).
   bimart::runtime::ensure_blas_kernel(argc, argv);
+  bimart::runtime::tune_allocator();
 
   CLI::App app{"bimart: bimanual hand motion for articulated objects", "bimart"};
   app.require_subcommand(1);

@@ -15,10 +15,6 @@ namespace {
 
 double unit_interval(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
-Eigen::Matrix3d hinge_rotation(double angle) {
-  return Eigen::AngleAxisd(angle, -Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
-
 }  // namespace
 
 BpsBasis make_bps_basis(int count, double radius, std::uint64_t seed) {
@@ -113,7 +109,7 @@ ObjectEncoding encode_object(const ArticulatedObject& object, const at::Tensor& 
       out.features[t].copy_(out.features[t - 1]);
       out.hit_indices[t].copy_(out.hit_indices[t - 1]);
     } else {
-      const Eigen::Matrix3d R = hinge_rotation(angle);
+      const Eigen::Matrix3d R = top_to_canonical(angle).linear();
       moved = basis.points * R;  // rows R^T b: the basis in the top part's own frame
       top.nearest(moved, top_idx.data(), top_d2.data());
       auto write = [&](int row, int basis_index, const Eigen::Vector3d& hit, int64_t vertex) {

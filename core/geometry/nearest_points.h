@@ -5,9 +5,9 @@
 #include <Eigen/Core>
 #include <memory>
 
-namespace bimart {
+#include "core/geometry/triangle_mesh.h"
 
-using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+namespace bimart {
 
 class NearestPoints {
  public:

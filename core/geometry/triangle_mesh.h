@@ -6,6 +6,9 @@
 
 namespace bimart {
 
+// [M, 3] points, one per row (metres).
+using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
 struct TriangleMesh {
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices;
   Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces;

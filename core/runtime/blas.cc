@@ -107,6 +107,10 @@ void ensure_blas_kernel(int argc, char** argv) {
 
   setenv(kCoretypeEnv, value.c_str(), 1);
   setenv(kReexecGuardEnv, value.c_str(), 1);
+  // Restarting anyway: also stop OpenMP's spin-waiting, which halves 2-thread speed when the
+  // other core is busy (docs/performance.md). A user's own setting is kept.
+  const bool set_spin = std::getenv("GOMP_SPINCOUNT") == nullptr;
+  if (set_spin) setenv("GOMP_SPINCOUNT", "0", 1);
   std::fflush(nullptr);  // anything already printed must not be lost or printed twice
   execv("/proc/self/exe", args.data());
 
@@ -114,6 +118,7 @@ void ensure_blas_kernel(int argc, char** argv) {
   const int err = errno;
   unsetenv(kCoretypeEnv);
   unsetenv(kReexecGuardEnv);
+  if (set_spin) unsetenv("GOMP_SPINCOUNT");
   std::fprintf(stderr,
                "bimart: note: could not restart with %s=%s (%s); continuing with OpenBLAS's "
                "'%s' kernel\n",

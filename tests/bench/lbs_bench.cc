@@ -10,6 +10,7 @@
 
 #include "core/hand/lbs.h"
 #include "core/hand/lbs_torch.h"
+#include "core/runtime/allocator.h"
 #include "core/runtime/blas.h"
 #include "tests/hand/synthetic_model.h"
 
@@ -77,6 +78,7 @@ BENCHMARK(BM_LbsTorchFloat32ForwardBackward)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   bimart::runtime::ensure_blas_kernel(argc, argv);
+  bimart::runtime::tune_allocator();  // as bimart does
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -144,3 +144,21 @@ TEST(Cli, HelpForEachCommand) {
     EXPECT_HAS(r.output, "Usage");
   }
 }
+
+TEST(Cli, EncodersRunInAPipelineWithTheirShippedBases) {
+  const fs::path yaml = scratch("encoders.yaml");
+  const fs::path out = scratch("encoders/states.csv");
+  std::ofstream(yaml) << "name: encoders\nstages:\n"
+                         "  - {id: trajectory, use: trajectory.constant, params: {frames: 4, angle: 0.5}}\n"
+                         "  - {id: np, use: encoder.np_bps}\n"
+                         "  - {id: npa, use: encoder.npa_bps}\n"
+                         "  - {id: u, use: encoder.u_bps}\n"
+                         "  - {id: write, use: export.states_csv, params: {path: " + out.string() + "}}\n";
+  const Result r = bimart("run " + yaml.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_HAS(r.output, "np (encoder.np_bps)");
+  EXPECT_HAS(r.output, "u (encoder.u_bps)");
+  const Result bad = bimart("run " + yaml.string() + " --set np.basis=models/bps/npa_bps_1024.npz");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_HAS(bad.output, "this encoder needs 512");
+}

@@ -1,0 +1,39 @@
+// Signed distance to one closed triangle mesh (CGAL AABB tree, built once): closest point
+// for the distance, a robust inside test for the sign. Positive inside, negative outside
+// (DESIGN §6). Queries are in the mesh's own frame; callers move the points, not the mesh.
+#pragma once
+
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "core/geometry/triangle_mesh.h"
+
+namespace bimart {
+
+struct SurfaceQuery {
+  double signed_distance = 0;  // metres; > 0 inside
+  Eigen::Vector3d closest = Eigen::Vector3d::Zero();  // nearest surface point, mesh frame
+  int face = -1;                                      // face of the nearest point
+};
+
+class MeshDistance {
+ public:
+  // Throws bimart::Error when the mesh is empty or not closed (inside tests need closed meshes).
+  explicit MeshDistance(const TriangleMesh& mesh);
+  ~MeshDistance();
+  MeshDistance(MeshDistance&&) noexcept;
+  MeshDistance& operator=(MeshDistance&&) noexcept;
+
+  SurfaceQuery query(const Eigen::Vector3d& p) const;
+  double signed_distance(const Eigen::Vector3d& p) const;
+  bool inside(const Eigen::Vector3d& p) const;
+  // Row-wise signed distances of [M, 3] points; thread-safe (const queries).
+  Eigen::VectorXd signed_distances(const Points3& points) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace bimart

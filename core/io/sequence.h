@@ -1,0 +1,38 @@
+// A motion sequence file (.npz; docs/formats.md, "Sequence"): the object it uses, the
+// frame rate, the object's 7-DoF states and both hands in the ARCTIC field layout. The
+// one format that data synthesis, generation, refinement and `bimart eval` all read and
+// write. Writing is atomic.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <ATen/core/Tensor.h>
+
+#include "core/hand/hand_motion.h"
+
+namespace bimart {
+
+struct Sequence {
+  std::string name;      // e.g. "laptop_s0003_use_012"
+  // Where the object lives: a path to an object folder or YAML (core/object/object_io.h),
+  // relative to the sequence file's folder unless absolute.
+  std::string object;
+  std::string category;  // object family, "" when unknown
+  std::string kind;      // "grab", "use", or "" (free text for other sources)
+  double fps = 30.0;
+  at::Tensor object_states;  // [N, 7] float32, [angle, rx, ry, rz, tx, ty, tz]
+  HandMotion hands;          // N frames; `vertices` [2, N, V, 3] optional
+
+  std::int64_t num_frames() const { return object_states.defined() ? object_states.size(0) : 0; }
+  // Throws bimart::Error naming the field when shapes disagree or values are not finite.
+  void validate() const;
+};
+
+// Throws bimart::Error naming the file and key on any problem.
+Sequence read_sequence(const std::string& path);
+void write_sequence(const Sequence& sequence, const std::string& path);
+// The object path resolved against the sequence file's folder.
+std::string resolve_object_path(const Sequence& sequence, const std::string& sequence_path);
+
+}  // namespace bimart

@@ -1,0 +1,42 @@
+// Signed distance from world-space points to a posed articulated object (DESIGN §6): one
+// MeshDistance per part, built once in the part's own frame; each query moves the points
+// into the part's frame with the object state (parts are rigid). Positive inside.
+// The whole object is the union of both parts: sd = max(sd_top, sd_bottom).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "core/geometry/mesh_distance.h"
+#include "core/object/articulated_object.h"
+#include "core/object/object_state.h"
+
+namespace bimart {
+
+enum class ObjectPart { Top = 0, Bottom = 1, Whole = 2 };
+
+struct ObjectSurfaceQuery {
+  double signed_distance = 0;                         // metres; > 0 inside
+  Eigen::Vector3d closest = Eigen::Vector3d::Zero();  // nearest surface point, world frame
+  ObjectPart part = ObjectPart::Bottom;               // the part the nearest point lies on
+};
+
+class ObjectDistance {
+ public:
+  explicit ObjectDistance(const ArticulatedObject& object);
+
+  // One world-space point at one object state.
+  ObjectSurfaceQuery query(const ObjectState& state, const Eigen::Vector3d& p_world,
+                           ObjectPart part = ObjectPart::Whole) const;
+  // Row-wise signed distances of [M, 3] world points at one state.
+  Eigen::VectorXd signed_distances(const ObjectState& state, const Points3& points_world,
+                                   ObjectPart part = ObjectPart::Whole) const;
+
+  const MeshDistance& top() const { return top_; }
+  const MeshDistance& bottom() const { return bottom_; }
+
+ private:
+  MeshDistance top_;
+  MeshDistance bottom_;
+};
+
+}  // namespace bimart

@@ -1,0 +1,83 @@
+#include "core/features/contact_map.h"
+
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include "core/features/bps.h"
+#include "core/object/families/families.h"
+#include "core/object/object_state.h"
+#include "core/util/data_path.h"
+#include "core/util/error.h"
+
+namespace bimart {
+namespace {
+
+TEST(ContactMap, AnalyticDistances) {
+  // Two object points; the left hand has points at distance 0.03 and 0.05 from the first,
+  // the right hand sits 0.2 above the second.
+  at::Tensor obj = at::zeros({1, 2, 3}, at::kDouble);
+  obj[0][1][0] = 1.0;
+  at::Tensor hands = at::zeros({2, 1, 2, 3}, at::kDouble);
+  hands[0][0][0][1] = 0.03;
+  hands[0][0][1][2] = -0.05;
+  hands[1][0][0] = at::tensor({1.0, 0.0, 0.2}, at::kDouble);
+  hands[1][0][1] = at::tensor({1.0, 0.5, 0.0}, at::kDouble);
+  const at::Tensor c = contact_maps(obj, hands);
+  ASSERT_EQ(c.sizes(), (at::IntArrayRef{1, 2, 2}));
+  EXPECT_NEAR(c[0][0][0].item<double>(), 0.03, 1e-15);
+  EXPECT_NEAR(c[0][0][1].item<double>(), std::sqrt(1.0 + 0.03 * 0.03), 1e-15);
+  EXPECT_NEAR(c[0][1][1].item<double>(), 0.2, 1e-15);
+  EXPECT_NEAR(c[0][1][0].item<double>(), std::sqrt(1.0 + 0.04), 1e-15);
+}
+
+TEST(ContactMap, TreeAndPairwiseImplementationsAgree) {
+  at::manual_seed(3);
+  const at::Tensor obj = at::rand({6, 1024, 3}, at::kFloat) * 0.3;
+  const at::Tensor hands = at::rand({2, 6, 778, 3}, at::kFloat) * 0.3 + 0.05;
+  const at::Tensor a = contact_maps(obj, hands);
+  const at::Tensor b = contact_maps_exhaustive(obj, hands);
+  ASSERT_EQ(a.sizes(), (at::IntArrayRef{6, 2, 1024}));
+  EXPECT_LT((a - b).abs().max().item<float>(), 2e-7);
+}
+
+TEST(ContactMap, GradientPointsFromTheNearestHandPointToTheObjectPoint) {
+  at::Tensor obj = at::zeros({1, 1, 3}, at::kDouble);
+  at::Tensor hands = at::zeros({2, 1, 2, 3}, at::kDouble);
+  hands[0][0][0] = at::tensor({0.0, 0.0, 0.1}, at::kDouble);
+  hands[0][0][1] = at::tensor({0.0, 0.3, 0.0}, at::kDouble);
+  hands[1][0][0] = at::tensor({0.2, 0.0, 0.0}, at::kDouble);
+  hands[1][0][1] = at::tensor({0.0, 0.3, 0.0}, at::kDouble);
+  hands.requires_grad_(true);
+  contact_maps(obj, hands).sum().backward();
+  const at::Tensor g = hands.grad();
+  // d||p - o|| / dp = (p - o) / ||p - o||, for the nearest point only.
+  EXPECT_NEAR(g[0][0][0][2].item<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(g[1][0][0][0].item<double>(), 1.0, 1e-12);
+  EXPECT_EQ(g[0][0][1].abs().sum().item<double>(), 0.0);
+}
+
+TEST(ContactMap, HitPointsAreTheEncodersHitVertices) {
+  const ArticulatedObject o = make_object("laptop", 2);
+  at::Tensor s = at::zeros({2, 7});
+  s[0][0] = 0.4;
+  s[1][0] = 1.3;
+  s[1][4] = 0.5;  // root pose does not enter the canonical frame
+  const BpsBasis basis = load_bps_basis(find_data_file(default_basis_file(BpsVariant::PerPart)));
+  const ObjectEncoding e = encode_object(o, s, basis, BpsVariant::PerPart);
+  const at::Tensor p = basis_hit_points(o, s, e.hit_indices);
+  ASSERT_EQ(p.sizes(), (at::IntArrayRef{2, 1024, 3}));
+  // Scaled by s_o, a hit point is basis point + feature.
+  const at::Tensor expected = (e.basis_points.unsqueeze(0) + e.features) / e.scale;
+  EXPECT_LT((p - expected).abs().max().item<float>(), 1e-5);
+}
+
+TEST(ContactMap, BadShapesAreClearErrors) {
+  EXPECT_THROW(contact_maps(at::zeros({2, 5, 3}), at::zeros({2, 3, 4, 3})), Error);
+  EXPECT_THROW(contact_maps(at::zeros({2, 5}), at::zeros({2, 2, 4, 3})), Error);
+  const ArticulatedObject o = make_object("box", 0);
+  at::Tensor idx = at::full({1, 1024}, o.top.num_vertices() + o.bottom.num_vertices(), at::kLong);
+  EXPECT_THROW(basis_hit_points(o, at::zeros({1, 7}), idx), Error);
+}
+
+}  // namespace
+}  // namespace bimart
