@@ -4,9 +4,10 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BIMART_BUILD_DIR:-$root/build}
+mkdir -p "$build"
 
-cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE="${BIMART_BUILD_TYPE:-Release}" "$@" > "$build.configure.log" 2>&1 \
-  || { cat "$build.configure.log"; echo "build: CMake configure failed (log above)"; exit 1; }
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE="${BIMART_BUILD_TYPE:-Release}" "$@" > "$build/configure.log" 2>&1 \
+  || { cat "$build/configure.log"; echo "build: CMake configure failed (log above)"; exit 1; }
 echo "build: compiling into $build (a first build takes a few minutes)"
 # Show warnings and errors, not the progress lines.
 set +e

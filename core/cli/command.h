@@ -24,4 +24,5 @@ void add_pipeline_commands(CLI::App& app, Commands& out);  // run, graph, plugin
 void add_bps_commands(CLI::App& app, Commands& out);       // bps make
 void add_object_commands(CLI::App& app, Commands& out);    // object make, list, info, gallery
 void add_hand_commands(CLI::App& app, Commands& out);      // hand make
+void add_eval_commands(CLI::App& app, Commands& out);      // eval
 }  // namespace bimart::cli

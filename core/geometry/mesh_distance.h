@@ -1,6 +1,7 @@
 // Signed distance to one closed triangle mesh (CGAL AABB tree, built once): closest point
 // for the distance, a robust inside test for the sign. Positive inside, negative outside
 // (DESIGN §6). Queries are in the mesh's own frame; callers move the points, not the mesh.
+// A mesh may hold several closed components that overlap: inside = inside any of them.
 #pragma once
 
 #include <memory>
@@ -30,6 +31,13 @@ class MeshDistance {
   bool inside(const Eigen::Vector3d& p) const;
   // Row-wise signed distances of [M, 3] points; thread-safe (const queries).
   Eigen::VectorXd signed_distances(const Points3& points) const;
+  // Closed components (by shared vertices). A part may be a union of overlapping closed
+  // components; "inside" means inside any of them (ray parity runs per component).
+  int num_components() const;
+  // max over the rows of signed_distances(points), without computing every distance: rows
+  // that cannot beat the best so far (bounded by the mesh's bounding box) are skipped.
+  // -infinity for no rows.
+  double max_signed_distance(const Points3& points) const;
 
  private:
   struct Impl;

@@ -23,6 +23,10 @@ struct Sequence {
   double fps = 30.0;
   at::Tensor object_states;  // [N, 7] float32, [angle, rx, ry, rz, tx, ty, tz]
   HandMotion hands;          // N frames; `vertices` [2, N, V, 3] optional
+  // Optional, for the CM metric of generated sequences: the contact maps that conditioned
+  // the motion [N, 2, 1024] float32 (m) and the encoder's basis_hit_indices [N, 1024] int64.
+  at::Tensor contact_maps;
+  at::Tensor basis_hit_indices;
 
   std::int64_t num_frames() const { return object_states.defined() ? object_states.size(0) : 0; }
   // Throws bimart::Error naming the field when shapes disagree or values are not finite.

@@ -31,6 +31,11 @@ class ObjectDistance {
   Eigen::VectorXd signed_distances(const ObjectState& state, const Points3& points_world,
                                    ObjectPart part = ObjectPart::Whole) const;
 
+  // max over the rows of signed_distances(state, points_world, part), with pruning
+  // (MeshDistance::max_signed_distance): the deepest point, as Pen, Con and Art need.
+  double max_signed_distance(const ObjectState& state, const Points3& points_world,
+                             ObjectPart part = ObjectPart::Whole) const;
+
   const MeshDistance& top() const { return top_; }
   const MeshDistance& bottom() const { return bottom_; }
 

@@ -265,7 +265,8 @@ TEST(ProceduralHand, CheckedInModelsEqualAFreshHand) {
     EXPECT_LT((m.shapedirs - fresh->shapedirs).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((m.j_regressor - fresh->j_regressor).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((m.weights - fresh->weights).cwiseAbs().maxCoeff(), 1e-12);
-    EXPECT_LT((m.hands_components - fresh->hands_components).cwiseAbs().maxCoeff(), 1e-12);
+    // An eigensolver's vectors differ by round-off (~1e-11) between builds and CPUs.
+    EXPECT_LT((m.hands_components - fresh->hands_components).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LT((m.hands_mean - fresh->hands_mean).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_EQ(m.fingertips, fresh->fingertips);
     EXPECT_EQ(m.keypoints, fresh->keypoints);

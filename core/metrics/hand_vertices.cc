@@ -1,0 +1,78 @@
+#include "core/metrics/hand_vertices.h"
+
+#include <array>
+#include <mutex>
+#include <string>
+
+#include <ATen/ATen.h>
+
+#include "core/hand/hand_model.h"
+#include "core/hand/keypoints.h"
+#include "core/hand/lbs_torch.h"
+#include "core/util/data_path.h"
+#include "core/util/error.h"
+
+namespace bimart {
+namespace {
+
+struct ShippedHands {
+  std::array<HandModelTensors, 2> tensors;
+  std::array<std::vector<int64_t>, 2> keypoints;
+};
+
+// Loaded on first use, then shared by every thread (read-only).
+const ShippedHands& shipped_hands() {
+  static std::once_flag once;
+  static ShippedHands hands;
+  std::call_once(once, [] {
+    const char* files[2] = {"models/hand/mano_left.npz", "models/hand/mano_right.npz"};
+    for (int h = 0; h < 2; ++h) {
+      const HandModel model = load_hand_model(find_data_file(files[h]));
+      hands.tensors[h] = HandModelTensors::from(model, at::kFloat);
+      const std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
+      hands.keypoints[h].assign(ids.begin(), ids.end());
+    }
+  });
+  return hands;
+}
+
+}  // namespace
+
+at::Tensor hand_vertices(const HandMotion& motion) {
+  const int64_t n = motion.num_frames();
+  if (motion.has_vertices()) {
+    const at::Tensor& v = motion.vertices;
+    if (v.dim() != 4 || v.size(0) != 2 || v.size(1) != n || v.size(3) != 3)
+      throw Error("hand vertices must be [2, N, V, 3] with N = " + std::to_string(n) + " frames");
+    return v.to(at::kCPU, at::kFloat).contiguous();
+  }
+  if (n < 1) throw Error("hand motion has no frames");
+  const ShippedHands& models = shipped_hands();
+  std::vector<at::Tensor> per_hand;
+  at::NoGradGuard no_grad;
+  for (int h = 0; h < 2; ++h) {
+    const HandParams& p = motion.hands[static_cast<size_t>(h)];
+    auto f = [](const at::Tensor& t) { return t.detach().to(at::kCPU, at::kFloat).contiguous(); };
+    const at::Tensor betas = f(p.shape).reshape({1, -1}).expand({n, -1}).contiguous();
+    per_hand.push_back(lbs(models.tensors[h], f(p.rot), f(p.pose), f(p.trans), betas).vertices);
+  }
+  return at::stack(per_hand).contiguous();
+}
+
+at::Tensor hand_keypoints(const HandMotion& motion) {
+  const at::Tensor v = hand_vertices(motion);
+  const ShippedHands& models = shipped_hands();
+  std::vector<at::Tensor> per_hand;
+  for (int h = 0; h < 2; ++h) {
+    const auto& ids = models.keypoints[h];
+    for (int64_t id : ids)
+      if (id >= v.size(2))
+        throw Error("hand vertices have " + std::to_string(v.size(2)) +
+                    " vertices per hand; the hand model's keypoints need " + std::to_string(id + 1));
+    const at::Tensor idx = at::tensor(ids, at::kLong);
+    per_hand.push_back(v[h].index_select(1, idx));
+  }
+  return at::stack(per_hand).contiguous();
+}
+
+}  // namespace bimart

@@ -1,0 +1,20 @@
+// The hand points every metric works on (DESIGN §6): both hands' mesh vertices per frame in
+// the world frame, and the J surface keypoints for the contact-map measure.
+#pragma once
+
+#include <ATen/core/Tensor.h>
+
+#include "core/hand/hand_motion.h"
+
+namespace bimart {
+
+// [2, N, V, 3] float32, world frame: `motion.vertices` when present, otherwise posed with
+// batched LBS (core/hand/lbs_torch.h) from the shipped models
+// models/hand/mano_{left,right}.npz (found with core/util/data_path.h; loaded once).
+at::Tensor hand_vertices(const HandMotion& motion);
+
+// [2, N, J, 3] float32: the J = 100 surface keypoints (the model's keypoint vertex ids)
+// taken from hand_vertices(motion).
+at::Tensor hand_keypoints(const HandMotion& motion);
+
+}  // namespace bimart

@@ -1,0 +1,14 @@
+#include "core/metrics/penetration.h"
+
+namespace bimart {
+
+FrameCount penetration_frames(const FrameDepths& depths, double threshold) {
+  FrameCount c;
+  for (size_t t = 0; t < depths.size(); ++t) {
+    ++c.frames;
+    if (depths.whole(t) > threshold) ++c.hits;
+  }
+  return c;
+}
+
+}  // namespace bimart

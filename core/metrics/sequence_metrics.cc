@@ -1,0 +1,93 @@
+#include "core/metrics/sequence_metrics.h"
+
+#include <cmath>
+
+#include "core/metrics/accel.h"
+#include "core/metrics/articulation.h"
+#include "core/metrics/contact.h"
+#include "core/metrics/contact_map_error.h"
+#include "core/metrics/frame_depths.h"
+#include "core/metrics/penetration.h"
+
+namespace bimart {
+
+SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectDistance& distance,
+                                  const SequenceData& d) {
+  SequenceMetrics m;
+  m.name = d.name;
+  m.frames = d.object_states.size(0);
+  m.accel = mean_acceleration(d.hand_vertices);
+  const FrameDepths depths = frame_depths(distance, d.object_states, d.hand_vertices);
+  m.pen_1cm = penetration_frames(depths, kPenetration1cm);
+  m.pen_5mm = penetration_frames(depths, kPenetration5mm);
+  m.contact = contact_frames(depths, object_moving_frames(object, d.object_states));
+  m.articulation = articulation_frames(depths, angle_changing_frames(d.object_states));
+  if (d.contact_maps.defined() && d.basis_hit_indices.defined() && d.hand_keypoints.defined())
+    m.contact_map = contact_map_error(object, d.object_states, d.basis_hit_indices, d.hand_keypoints,
+                                      d.contact_maps);
+  return m;
+}
+
+namespace {
+
+MetricResult mean_result(const char* name, const char* unit, bool higher, const std::vector<double>& values) {
+  MetricResult r;
+  r.name = name;
+  r.unit = unit;
+  r.higher_is_better = higher;
+  double sum = 0;
+  for (double v : values)
+    if (std::isfinite(v)) {
+      sum += v;
+      ++r.num_sequences;
+    }
+  r.value = r.num_sequences ? 100.0 * sum / static_cast<double>(r.num_sequences)
+                            : std::numeric_limits<double>::quiet_NaN();
+  return r;
+}
+
+}  // namespace
+
+MetricResult mul_result(const std::vector<double>& mul) { return mean_result("Mul", "cm", true, mul); }
+
+MetricResult accel_result(const std::vector<SequenceMetrics>& s) {
+  std::vector<double> v;
+  for (const auto& m : s) v.push_back(m.accel);
+  return mean_result("Accel", "cm/frame²", false, v);
+}
+
+MetricResult contact_map_result(const std::vector<SequenceMetrics>& s) {
+  std::vector<double> v;
+  for (const auto& m : s) v.push_back(m.contact_map);
+  return mean_result("CM", "cm", false, v);
+}
+
+MetricResult frame_share_result(const std::string& name, bool higher,
+                                const std::vector<SequenceMetrics>& s, FrameCount SequenceMetrics::*field) {
+  MetricResult r;
+  r.name = name;
+  r.unit = "%";
+  r.higher_is_better = higher;
+  r.frame_share = true;
+  for (const auto& m : s) {
+    r.numerator += (m.*field).hits;
+    r.denominator += (m.*field).frames;
+  }
+  r.num_sequences = static_cast<std::int64_t>(s.size());
+  r.value = r.denominator ? 100.0 * static_cast<double>(r.numerator) / static_cast<double>(r.denominator)
+                          : std::numeric_limits<double>::quiet_NaN();
+  return r;
+}
+
+std::vector<MetricResult> aggregate_metrics(const std::vector<SequenceMetrics>& s,
+                                            const std::vector<double>& mul) {
+  return {mul_result(mul),
+          accel_result(s),
+          frame_share_result("Pen 1cm", false, s, &SequenceMetrics::pen_1cm),
+          frame_share_result("Pen 5mm", false, s, &SequenceMetrics::pen_5mm),
+          frame_share_result("Con", true, s, &SequenceMetrics::contact),
+          frame_share_result("Art", true, s, &SequenceMetrics::articulation),
+          contact_map_result(s)};
+}
+
+}  // namespace bimart

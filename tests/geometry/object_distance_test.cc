@@ -1,0 +1,108 @@
+#include "core/object/object_distance.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/object/families/families.h"
+#include "core/object/object_state.h"
+
+namespace bimart {
+namespace {
+
+TriangleMesh with_vertices(const TriangleMesh& m, const PartVertices& v) {
+  TriangleMesh out = m;
+  out.vertices = v;
+  return out;
+}
+
+// Moving the points into each part's frame gives the same as posing the meshes in the
+// world and querying there (the second implementation rebuilds the trees per state).
+TEST(ObjectDistance, MatchesQueriesOnWorldPosedMeshes) {
+  const ArticulatedObject object = make_object("laptop", 3);
+  const ObjectDistance od(object);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int s = 0; s < 3; ++s) {
+    ObjectState state;
+    state.angle = 0.3 + 0.5 * s;
+    state.root_rotation = Eigen::Vector3d(u(rng), u(rng), u(rng));
+    state.root_translation = Eigen::Vector3d(u(rng), u(rng), u(rng)) * 0.2;
+    const PosedObject posed = pose_world(object, state);
+    const MeshDistance top(with_vertices(object.top, posed.top));
+    const MeshDistance bottom(with_vertices(object.bottom, posed.bottom));
+    Points3 pts(500, 3);
+    for (Eigen::Index i = 0; i < pts.rows(); ++i) {
+      const Eigen::Index k = i % posed.bottom.rows();
+      const Eigen::Vector3d base = (i % 2 ? posed.top.row(i % posed.top.rows()) : posed.bottom.row(k)).transpose();
+      pts.row(i) = (base + 0.02 * Eigen::Vector3d(u(rng), u(rng), u(rng))).transpose();
+    }
+    const Eigen::VectorXd t = od.signed_distances(state, pts, ObjectPart::Top);
+    const Eigen::VectorXd b = od.signed_distances(state, pts, ObjectPart::Bottom);
+    const Eigen::VectorXd w = od.signed_distances(state, pts);
+    const Eigen::VectorXd t2 = top.signed_distances(pts), b2 = bottom.signed_distances(pts);
+    EXPECT_LT((t - t2).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT((b - b2).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT((w - t2.cwiseMax(b2)).cwiseAbs().maxCoeff(), 1e-9);
+    int inside = 0;
+    for (Eigen::Index i = 0; i < pts.rows(); ++i) {
+      const ObjectSurfaceQuery q = od.query(state, pts.row(i).transpose());
+      EXPECT_NEAR(q.signed_distance, w(i), 1e-9);
+      EXPECT_NEAR((q.closest - pts.row(i).transpose()).norm(), std::abs(w(i)), 1e-9);
+      EXPECT_EQ(q.part, t(i) > b(i) ? ObjectPart::Top : ObjectPart::Bottom);
+      inside += w(i) > 0;
+    }
+    EXPECT_GT(inside, 10);  // the sample reaches inside the parts
+  }
+}
+
+// The pruned maximum equals the maximum of all distances (far, near and inside sets).
+TEST(ObjectDistance, PrunedMaximumMatchesTheFullMaximum) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  for (const char* category : {"laptop", "scissors", "box"}) {
+    const ArticulatedObject object = make_object(category, 2);
+    const ObjectDistance od(object);
+    for (int trial = 0; trial < 12; ++trial) {
+      ObjectState state;
+      state.angle = 0.1 * trial;
+      state.root_rotation = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.5;
+      state.root_translation = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.1;
+      const PosedObject posed = pose_world(object, state);
+      const double spread = trial % 3 == 0 ? 0.3 : (trial % 3 == 1 ? 0.01 : 0.002);
+      Points3 pts(300, 3);
+      for (Eigen::Index i = 0; i < pts.rows(); ++i) {
+        const PartVertices& part = i % 2 ? posed.top : posed.bottom;
+        pts.row(i) = part.row(static_cast<Eigen::Index>(rng() % static_cast<uint64_t>(part.rows())));
+        pts.row(i) += spread * Eigen::RowVector3d(g(rng), g(rng), g(rng));
+      }
+      for (ObjectPart part : {ObjectPart::Top, ObjectPart::Bottom, ObjectPart::Whole})
+        EXPECT_NEAR(od.max_signed_distance(state, pts, part), od.signed_distances(state, pts, part).maxCoeff(),
+                    1e-12)
+            << category << " trial " << trial;
+    }
+  }
+}
+
+TEST(ObjectDistance, BoxPartsKnownDepths) {
+  // Bottom: the box below y = 0; top: the box above it, hinged at the origin about -z.
+  ArticulatedObject o;
+  o.bottom = make_box({-0.2, -0.02, -0.1}, {0, 0, 0.1});
+  o.top = make_box({-0.2, 0, -0.1}, {0, 0.01, 0.1});
+  const ObjectDistance od(o);
+  ObjectState s;
+  s.root_translation = Eigen::Vector3d(1, 2, 3);
+  EXPECT_NEAR(od.signed_distances(s, Points3(Eigen::RowVector3d(0.9, 1.99, 3)), ObjectPart::Bottom)(0),
+              0.01, 1e-9);
+  EXPECT_NEAR(od.signed_distances(s, Points3(Eigen::RowVector3d(0.9, 2.03, 3)), ObjectPart::Top)(0),
+              -0.02, 1e-9);
+  // Open by 90°: the top part now lies along +y from the hinge (x in [0, 0.01]).
+  s.angle = M_PI / 2;
+  EXPECT_NEAR(od.signed_distances(s, Points3(Eigen::RowVector3d(1.005, 2.1, 3)), ObjectPart::Top)(0),
+              0.005, 1e-9);
+  EXPECT_NEAR(od.signed_distances(s, Points3(Eigen::RowVector3d(1.005, 2.1, 3)), ObjectPart::Bottom)(0),
+              -std::hypot(0.005, 0.1), 1e-9);
+}
+
+}  // namespace
+}  // namespace bimart

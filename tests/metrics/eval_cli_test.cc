@@ -1,0 +1,122 @@
+// `bimart eval` end to end through the CLI binary on a tiny generated folder.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <ATen/ATen.h>
+#include <nlohmann/json.hpp>
+
+#include "core/io/sequence.h"
+#include "core/object/families/families.h"
+#include "core/object/object_io.h"
+
+namespace bimart {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status;
+  std::string output;
+};
+
+CliRun run_cli(const std::string& args) {
+  const std::string cmd = std::string(BIMART_CLI) + " eval " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  return {pclose(p), out};
+}
+
+// Hands hovering 2 cm above the closed box's lid at x = -0.05, moved by `offset` (m) in z.
+Sequence sequence(const std::string& name, const at::Tensor& states, double offset) {
+  const int64_t n = states.size(0), v = 4;
+  Sequence s;
+  s.name = name;
+  s.object = "../objects/box";
+  s.category = "box";
+  s.kind = "use";
+  s.object_states = states;
+  for (auto& h : s.hands.hands) {
+    h.rot = at::zeros({n, 3});
+    h.pose = at::zeros({n, 45});
+    h.trans = at::zeros({n, 3});
+    h.shape = at::zeros({10});
+  }
+  s.hands.vertices = at::zeros({2, n, v, 3});
+  s.hands.vertices.select(3, 0).fill_(-0.05);
+  s.hands.vertices.select(3, 1).fill_(0.5);  // far above
+  s.hands.vertices.select(3, 2).fill_(offset);
+  return s;
+}
+
+TEST(EvalCli, TableAndJsonOnATinyFolder) {
+  const fs::path dir = fs::temp_directory_path() / ("bimart_eval_cli_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  save_object(make_object("box", 1), (dir / "objects" / "box").string());
+  at::Tensor still = at::zeros({8, 7});
+  at::Tensor moving = at::zeros({8, 7});
+  moving.select(1, 4).copy_(at::arange(8, at::kFloat) * 0.01);
+  moving.select(1, 0).copy_(at::arange(8, at::kFloat) * 0.05);
+  // Two samples of one trajectory 3 cm apart, and one other trajectory.
+  write_sequence(sequence("a_s0", moving, 0.0), (dir / "gen" / "a_s0.npz").string());
+  write_sequence(sequence("a_s1", moving, 0.03), (dir / "gen" / "a_s1.npz").string());
+  Sequence b = sequence("b", still, 0.0);
+  b.object = "../../objects/box";  // relative to the file's own folder
+  write_sequence(b, (dir / "gen" / "sub" / "b.npz").string());
+  // A "data set" with a manifest: only the test split is read.
+  write_sequence(sequence("gt0", moving, 0.0), (dir / "data" / "seq" / "gt0.npz").string());
+  write_sequence(sequence("gt1", still, 0.0), (dir / "data" / "seq" / "gt1.npz").string());
+  std::ofstream(dir / "data" / "manifest.json") << R"({"train": ["seq/gt1.npz"], "test": ["seq/gt0.npz"]})";
+  // The data set's sequences refer to ../objects relative to data/seq.
+  fs::create_directories(dir / "data" / "objects");
+  fs::copy(dir / "objects" / "box", dir / "data" / "objects" / "box");
+
+  const fs::path json = dir / "out" / "eval.json";
+  const CliRun r = run_cli((dir / "gen").string() + " --ground-truth " + (dir / "data").string() +
+                    " --split test --json " + json.string() + " --threads 2");
+  // --split applies to both folders; the generated folder has no manifest.
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("manifest.json"), std::string::npos) << r.output;
+
+  const CliRun ok = run_cli((dir / "gen").string() + " --json " + json.string() + " --threads 2");
+  ASSERT_EQ(ok.status, 0) << ok.output;
+  std::cout << ok.output;
+  EXPECT_NE(ok.output.find("Mul"), std::string::npos) << ok.output;
+  EXPECT_NE(ok.output.find("Pen 1cm"), std::string::npos);
+  nlohmann::json j;
+  std::ifstream(json) >> j;
+  const auto& g = j["generated"];
+  EXPECT_EQ(g["sequences"], 3);
+  EXPECT_EQ(g["trajectories"], 2);
+  EXPECT_EQ(g["metrics"][0]["name"], "Mul");
+  EXPECT_NEAR(g["metrics"][0]["value"].get<double>(), 3.0, 1e-4);  // cm
+  EXPECT_EQ(g["metrics"][1]["name"], "Accel");
+  EXPECT_NEAR(g["metrics"][1]["value"].get<double>(), 0.0, 1e-6);  // hands do not move
+  EXPECT_EQ(g["metrics"][2]["name"], "Pen 1cm");
+  EXPECT_EQ(g["metrics"][2]["denominator"], 24);  // all frames of all sequences
+  EXPECT_EQ(g["metrics"][2]["numerator"], 0);
+  EXPECT_EQ(g["metrics"][4]["name"], "Con");
+  EXPECT_EQ(g["metrics"][4]["denominator"], 14);  // 7 moving frames in each of a_s0, a_s1
+  EXPECT_EQ(g["metrics"][4]["numerator"], 0);     // hands half a metre away
+  EXPECT_EQ(g["metrics"][5]["name"], "Art");
+  EXPECT_EQ(g["metrics"][5]["denominator"], 14);
+  EXPECT_TRUE(g["metrics"][6]["value"].is_null());  // no conditioning maps stored: no CM
+  EXPECT_EQ(g["per_sequence"].size(), 3u);
+
+  const CliRun gt = run_cli("--ground-truth " + (dir / "data").string() + " --split test --quiet");
+  ASSERT_EQ(gt.status, 0) << gt.output;
+  EXPECT_NE(gt.output.find("ground truth (1)"), std::string::npos) << gt.output;
+
+  const CliRun empty = run_cli((dir / "objects").string());
+  EXPECT_NE(empty.status, 0);
+  EXPECT_NE(empty.output.find("no .npz"), std::string::npos) << empty.output;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace bimart
