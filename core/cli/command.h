@@ -25,4 +25,5 @@ void add_bps_commands(CLI::App& app, Commands& out);       // bps make
 void add_object_commands(CLI::App& app, Commands& out);    // object make, list, info, gallery
 void add_hand_commands(CLI::App& app, Commands& out);      // hand make
 void add_eval_commands(CLI::App& app, Commands& out);      // eval
+void add_data_commands(CLI::App& app, Commands& out);      // data synth, data stats
 }  // namespace bimart::cli

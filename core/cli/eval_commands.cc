@@ -28,6 +28,8 @@
 #include "core/runtime/blas.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
+#include "core/util/parallel.h"
+#include "core/util/progress.h"
 
 namespace bimart::cli {
 namespace {
@@ -95,58 +97,6 @@ class ObjectCache {
   std::map<std::string, std::pair<std::shared_ptr<std::once_flag>, std::shared_ptr<Entry>>> entries_;
 };
 
-class Progress {
- public:
-  Progress(std::string label, size_t total, bool show) : label_(std::move(label)), total_(total), show_(show) { draw(); }
-  void step() {
-    ++done_;
-    draw();
-  }
-  ~Progress() {
-    if (show_) std::cerr << "\n";
-  }
-
- private:
-  void draw() {
-    if (!show_) return;
-    std::lock_guard<std::mutex> lock(mutex_);
-    const size_t done = done_;
-    const int width = 30;
-    const int filled = total_ ? static_cast<int>(width * done / total_) : width;
-    std::cerr << fmt::format("\r{} [{}{}] {}/{}", label_, std::string(filled, '#'),
-                             std::string(width - filled, ' '), done, total_)
-              << std::flush;
-  }
-  std::string label_;
-  size_t total_;
-  bool show_;
-  std::atomic<size_t> done_{0};
-  std::mutex mutex_;
-};
-
-// Runs job(i) for i in [0, n) on `threads` threads; the first error is rethrown.
-void parallel_for(size_t n, int threads, const std::function<void(size_t)>& job) {
-  std::atomic<size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto worker = [&] {
-    for (size_t i; (i = next++) < n;) {
-      try {
-        job(i);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = n;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-}
-
 struct SetResult {
   std::string label, folder;
   std::vector<std::string> files;
@@ -187,7 +137,7 @@ SetResult evaluate_set(const std::string& label, const std::string& folder, cons
   r.sequences.resize(n);
   std::vector<std::string> keys(n);
   {
-    Progress bar(label, n, progress);
+    ProgressBar bar(label, n, progress);
     parallel_for(n, threads, [&](size_t i) {
       const Sequence s = read_sequence(r.files[i]);
       const std::string object_path = resolve_object_path(s, r.files[i]);

@@ -241,6 +241,17 @@ double MeshDistance::max_signed_distance(const Points3& points) const {
   return best;
 }
 
+bool MeshDistance::any_deeper_than(const Points3& points, double threshold) const {
+  const Eigen::Vector3d lo = impl_->lo, hi = impl_->hi;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Eigen::Vector3d p = points.row(i).transpose();
+    // Deeper than `threshold` needs a point at least that far inside the bounding box.
+    if ((p - lo).cwiseMin(hi - p).minCoeff() <= threshold) continue;
+    if (depth_inside(impl_->components, Point(p.x(), p.y(), p.z()), nullptr) > threshold) return true;
+  }
+  return false;
+}
+
 int MeshDistance::num_components() const { return static_cast<int>(impl_->components.size()); }
 
 Eigen::VectorXd MeshDistance::signed_distances(const Points3& points) const {

@@ -38,6 +38,9 @@ class MeshDistance {
   // that cannot beat the best so far (bounded by the mesh's bounding box) are skipped.
   // -infinity for no rows.
   double max_signed_distance(const Points3& points) const;
+  // max_signed_distance(points) > threshold, for threshold >= 0, but cheaper: only inside
+  // tests, a distance only for points inside, and it stops at the first such point.
+  bool any_deeper_than(const Points3& points, double threshold) const;
 
  private:
   struct Impl;

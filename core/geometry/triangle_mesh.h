@@ -20,4 +20,7 @@ struct TriangleMesh {
 // An axis-aligned box [min, max] as a closed mesh of 8 vertices and 12 outward faces.
 TriangleMesh make_box(const Eigen::Vector3d& min, const Eigen::Vector3d& max);
 
+// Unit area-weighted vertex normals [V, 3] (outwards for outward faces; zero for unused vertices).
+Eigen::MatrixX3d vertex_normals(const TriangleMesh& mesh);
+
 }  // namespace bimart

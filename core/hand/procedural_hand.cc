@@ -457,7 +457,12 @@ HandSkeleton procedural_hand_skeleton(HandSide side, const Eigen::VectorXd& beta
 }
 
 Eigen::VectorXd procedural_curl_pose(HandSide side, double curl, double thumb_curl) {
-  const Eigen::VectorXd right = synergy_pose({curl, curl, curl, curl, thumb_curl}, {0, 0, 0, 0, 0});
+  return procedural_digit_pose(side, {curl, curl, curl, curl, thumb_curl}, {0, 0, 0, 0, 0});
+}
+
+Eigen::VectorXd procedural_digit_pose(HandSide side, const std::array<double, 5>& curl,
+                                      const std::array<double, 5>& spread) {
+  const Eigen::VectorXd right = synergy_pose(curl, spread);
   return side == HandSide::Left ? mirror_pose(right) : right;
 }
 

@@ -55,4 +55,11 @@ const std::array<std::string, 10>& procedural_shape_names();
 // synergy the PCA basis is sampled from.
 Eigen::VectorXd procedural_curl_pose(HandSide side, double curl, double thumb_curl);
 
+// The same synergy per digit, in MANO digit order (index, middle, pinky, ring, thumb): each
+// digit's curl (0 straight, 1 a loose fist) and its spread in the palm plane (rad, about
+// the palm normal at the first joint). Linear in both, so blending two such poses blends
+// their curls.
+Eigen::VectorXd procedural_digit_pose(HandSide side, const std::array<double, 5>& curl,
+                                      const std::array<double, 5>& spread);
+
 }  // namespace bimart

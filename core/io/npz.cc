@@ -177,6 +177,8 @@ class HeaderParser {
   size_t i_ = 0;
 };
 
+constexpr time_t kFixedMemberTime = 315576000;  // 1980-01-01 12:00 UTC
+
 std::string zip_message(int code) {
   zip_error_t err;
   zip_error_init_with_code(&err, code);
@@ -446,6 +448,10 @@ void NpzFile::write(const std::string& path, NpzCompression compression) const {
       if (src) zip_source_free(src);
       throw Error(where(key) + ": cannot add to archive '" + path + "': " + zip_strerror(za));
     }
+    // A fixed member time (1980-01-01 12:00, DOS time has no earlier date) instead of "now",
+    // so the same arrays give byte-identical files (data synthesis promises that).
+    if (zip_file_set_mtime(za, static_cast<zip_uint64_t>(idx), kFixedMemberTime, 0) != 0)
+      throw Error(where(key) + ": cannot set the member time: " + zip_strerror(za));
     const zip_int32_t method = compression == NpzCompression::Deflate ? ZIP_CM_DEFLATE : ZIP_CM_STORE;
     if (zip_set_file_compression(za, idx, method, 0) != 0)
       throw Error(where(key) + ": cannot set compression: " + zip_strerror(za));

@@ -19,22 +19,6 @@ namespace {
 
 constexpr double kNear = 1e-3;  // metres in front of the eye
 
-// Area-weighted vertex normals (the cross product's length is twice the triangle area).
-Eigen::MatrixX3d vertex_normals(const TriangleMesh& m) {
-  Eigen::MatrixX3d n = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
-  for (Eigen::Index f = 0; f < m.num_faces(); ++f) {
-    const Eigen::Vector3d a = m.vertices.row(m.faces(f, 0)), b = m.vertices.row(m.faces(f, 1)),
-                          c = m.vertices.row(m.faces(f, 2));
-    const Eigen::RowVector3d fn = (b - a).cross(c - a).transpose();
-    for (int k = 0; k < 3; ++k) n.row(m.faces(f, k)) += fn;
-  }
-  for (Eigen::Index v = 0; v < n.rows(); ++v) {
-    const double len = n.row(v).norm();
-    if (len > 0) n.row(v) /= len;
-  }
-  return n;
-}
-
 std::uint8_t to_byte(double c) { return static_cast<std::uint8_t>(std::lround(std::clamp(c, 0.0, 1.0) * 255.0)); }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <zip.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -114,6 +115,26 @@ TEST_F(NpzTest, DeflateShrinksRepetitiveData) {
   npz.write(path("s.npz"), NpzCompression::Store);
   EXPECT_GT(fs::file_size(path("s.npz")), 800000u);
   EXPECT_LT(fs::file_size(path("d.npz")), 10000u);
+}
+
+// The same arrays give the same bytes: members carry a fixed time, not the clock's.
+TEST_F(NpzTest, MembersCarryAFixedTimeSoFilesAreReproducible) {
+  const NpzFile npz = every_dtype();
+  npz.write(path("a.npz"), NpzCompression::Deflate);
+  int err = 0;
+  zip_t* za = zip_open(path("a.npz").c_str(), ZIP_RDONLY, &err);
+  ASSERT_NE(za, nullptr);
+  zip_stat_t st;
+  ASSERT_EQ(zip_stat(za, "f8.npy", 0, &st), 0);
+  zip_discard(za);
+  ASSERT_TRUE(st.valid & ZIP_STAT_MTIME);
+  // 1980-01-01 12:00 in DOS time, read back through the local time zone: within a day.
+  EXPECT_LT(std::abs(static_cast<double>(st.mtime) - 315576000.0), 86400.0);
+  std::ifstream a(path("a.npz"), std::ios::binary);
+  const std::string first((std::istreambuf_iterator<char>(a)), std::istreambuf_iterator<char>());
+  npz.write(path("b.npz"), NpzCompression::Deflate);
+  std::ifstream b(path("b.npz"), std::ios::binary);
+  EXPECT_EQ(first, std::string((std::istreambuf_iterator<char>(b)), std::istreambuf_iterator<char>()));
 }
 
 // Headers byte for byte as numpy 1.24 writes them (np.save on the same arrays).

@@ -1,0 +1,65 @@
+// Per-feature normalisation of the diffusion models' data (DESIGN §5: "data normalised per
+// feature by mean/std stored with the model"; docs/data_loader.md): mean and standard
+// deviation of
+//   X (1200)                       hand features, the motion model's sample,
+//   [O flattened | G] (3072 + 7)   the object condition of both models,
+//   C (2048)                       contact maps, the contact model's sample and the motion
+//                                  model's condition,
+// over the TRAIN split only. Statistics are taken over every (window, real frame) pair —
+// each frame weighted by the number of windows it appears in, padding excluded — which is
+// the distribution WindowDataset::batch draws from; G's translation is per window anyway.
+// Accumulated in float64: per sequence (two passes), then combined in sequence order
+// (Chan et al.'s update). Standard deviations are floored at
+// `std_floor` (default 1e-3 in the feature's units, see the docs) so that a feature that is
+// constant on the training data is centred but not blown up on new data.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <ATen/core/Tensor.h>
+
+namespace bimart {
+
+class WindowDataset;
+
+constexpr double kNormalizationStdFloor = 1e-3;
+constexpr int kObjectConditionSize = 1024 * 3 + 7;  // [O | G] per frame
+
+struct NormalizationStats {
+  std::string variant;      // encoder variant of O, e.g. "np_bps"
+  std::int64_t count = 0;   // (window, frame) pairs the statistics were taken over
+  double std_floor = kNormalizationStdFloor;
+  // float64; std already floored.
+  at::Tensor x_mean, x_std;      // [1200]
+  at::Tensor obj_mean, obj_std;  // [3079]
+  at::Tensor c_mean, c_std;      // [2048]
+
+  // X [..., 1200] -> normalised, same shape and dtype; and back.
+  at::Tensor normalize_x(const at::Tensor& x) const;
+  at::Tensor denormalize_x(const at::Tensor& x) const;
+  // O [..., 1024, 3] and G [..., 7] -> the normalised object condition [..., 3079].
+  at::Tensor normalize_object(const at::Tensor& object_features, const at::Tensor& global_states) const;
+  // C [..., 2, 1024] -> normalised, same shape; and back.
+  at::Tensor normalize_c(const at::Tensor& c) const;
+  at::Tensor denormalize_c(const at::Tensor& c) const;
+};
+
+// Over all windows of `train` (which should hold the train split). Throws when it is empty.
+NormalizationStats compute_normalization(const WindowDataset& train, double std_floor = kNormalizationStdFloor);
+
+// .npz with keys x_mean, x_std, obj_mean, obj_std, c_mean, c_std (f8), variant (string),
+// count (i8), std_floor (f8), format_version (i8); written atomically.
+void save_normalization(const NormalizationStats& stats, const std::string& path);
+// Throws bimart::Error naming the file and key on a missing key, a wrong shape or a
+// standard deviation that is not positive and finite.
+NormalizationStats load_normalization(const std::string& path);
+
+// [O flattened | G]: O [..., 1024, 3], G [..., 7] -> [..., 3079].
+at::Tensor object_condition(const at::Tensor& object_features, const at::Tensor& global_states);
+// (x - mean) / std and x * std + mean over the last dimension (mean, std [F]; broadcast
+// over the leading ones), in x's dtype.
+at::Tensor normalize(const at::Tensor& x, const at::Tensor& mean, const at::Tensor& std);
+at::Tensor denormalize(const at::Tensor& x, const at::Tensor& mean, const at::Tensor& std);
+
+}  // namespace bimart

@@ -1,0 +1,30 @@
+// A one-line progress bar on standard error for long work (DESIGN §8): "label [###   ] 3/10".
+// step() may be called from several threads. Drawn only when `show` is set.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <mutex>
+#include <string>
+
+namespace bimart {
+
+class ProgressBar {
+ public:
+  ProgressBar(std::string label, std::size_t total, bool show);
+  ~ProgressBar();  // ends the line
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+  void step();
+
+ private:
+  void draw();
+  std::string label_;
+  std::size_t total_;
+  bool show_;
+  std::atomic<std::size_t> done_{0};
+  std::mutex mutex_;
+};
+
+}  // namespace bimart
