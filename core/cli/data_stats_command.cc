@@ -75,10 +75,13 @@ void add_data_stats_command(CLI::App& data, Commands& out) {
   auto o = std::make_shared<StatsOptions>();
   CLI::App* stats = data.add_subcommand(
       "stats", "open a data set's train split (features, windows) and write its normalisation statistics");
-  stats->add_option("folder", o->folder, "data set folder (with manifest.json)")->required()->check(CLI::ExistingDirectory);
+  stats->add_option("folder", o->folder, "data set folder (with manifest.json)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   stats->add_option("--variant", o->variant, "object encoder: np_bps (default), npa_bps or u_bps")
       ->check(CLI::IsMember({"np_bps", "npa_bps", "u_bps"}));
-  stats->add_option("--out", o->out, "normalisation file to write (default: stats_<variant>.npz in the current folder)");
+  stats->add_option("--out", o->out,
+                    "normalisation file to write (default: stats_<variant>.npz in the current folder)");
   stats->add_option("--basis", o->basis, "BPS basis file (default: the variant's shipped file under models/bps/)")
       ->check(CLI::ExistingFile);
   stats->add_option("--stride", o->stride, "frames between window starts (default 16)")->check(CLI::PositiveNumber);

@@ -23,8 +23,7 @@ std::string type_name(const json& j) { return j.type_name(); }
 
 std::string read_string(const json& j, const std::string& key, const std::string& where) {
   if (!j.contains(key)) return "";
-  if (!j[key].is_string())
-    throw Error(where + ": field \"" + key + "\" must be a string, got " + type_name(j[key]));
+  if (!j[key].is_string()) throw Error(where + ": field \"" + key + "\" must be a string, got " + type_name(j[key]));
   return j[key].get<std::string>();
 }
 
@@ -118,7 +117,8 @@ DatasetManifest read_manifest(const std::string& folder) {
     if (!a.is_array()) throw Error(where + ": field \"objects\" must be a list, got " + type_name(a));
     for (size_t i = 0; i < a.size(); ++i) {
       const std::string field = "\"objects\"[" + std::to_string(i) + "]";
-      if (!a[i].is_object()) throw Error(where + ": field " + field + " must be an object {name, path, category, split}");
+      if (!a[i].is_object())
+        throw Error(where + ": field " + field + " must be an object {name, path, category, split}");
       const std::string w = where + ": field " + field;
       DatasetObject o;
       o.name = read_string(a[i], "name", w);
@@ -157,12 +157,11 @@ void write_manifest(const DatasetManifest& m, const std::string& folder) {
   write_file_atomically(file.string(), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
 }
 
-std::vector<std::string> split_files(const DatasetManifest& m, const std::string& folder,
-                                     const std::string& split) {
+std::vector<std::string> split_files(const DatasetManifest& m, const std::string& folder, const std::string& split) {
   const std::vector<std::string>* list = split == "train" ? &m.train : split == "test" ? &m.test : nullptr;
   if (!list)
-    throw Error("unknown data split '" + split + "'" + did_you_mean(split, kSplits) + " (known: " +
-                join(kSplits, ", ") + ")");
+    throw Error("unknown data split '" + split + "'" + did_you_mean(split, kSplits) +
+                " (known: " + join(kSplits, ", ") + ")");
   std::vector<std::string> out;
   out.reserve(list->size());
   for (const std::string& f : *list) out.push_back((fs::path(folder) / f).lexically_normal().string());

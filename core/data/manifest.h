@@ -47,7 +47,6 @@ void write_manifest(const DatasetManifest& m, const std::string& folder);
 
 // The files of `split` ("train" or "test") joined to `folder`, in manifest order. An
 // unknown split throws bimart::Error listing the known ones.
-std::vector<std::string> split_files(const DatasetManifest& m, const std::string& folder,
-                                     const std::string& split);
+std::vector<std::string> split_files(const DatasetManifest& m, const std::string& folder, const std::string& split);
 
 }  // namespace bimart

@@ -102,7 +102,8 @@ at::Tensor read_vector(const NpzFile& f, const std::string& key, int64_t size, b
   const std::vector<double> v = as_vector<double>(f.get(key, {size}), f.where(key));
   for (double x : v)
     if (!std::isfinite(x) || (positive && !(x > 0)))
-      throw Error(f.where(key) + ": holds " + std::to_string(x) + (positive ? " (must be positive and finite)" : " (not finite)"));
+      throw Error(f.where(key) + ": holds " + std::to_string(x) +
+                  (positive ? " (must be positive and finite)" : " (not finite)"));
   return at::tensor(v, at::kDouble);
 }
 
@@ -112,7 +113,8 @@ at::Tensor object_condition(const at::Tensor& object_features, const at::Tensor&
   const at::Tensor& o = object_features;
   const at::Tensor& g = global_states;
   if (!o.defined() || o.dim() < 2 || o.size(-1) != 3 || o.size(-2) != kBasisRows || !g.defined() ||
-      g.dim() != o.dim() - 1 || g.size(-1) != 7 || !o.sizes().slice(0, o.dim() - 2).equals(g.sizes().slice(0, g.dim() - 1)))
+      g.dim() != o.dim() - 1 || g.size(-1) != 7 ||
+      !o.sizes().slice(0, o.dim() - 2).equals(g.sizes().slice(0, g.dim() - 1)))
     throw Error("object condition: need O [..., 1024, 3] and G [..., 7] with the same leading dimensions, got " +
                 shape_str(o) + " and " + shape_str(g));
   return at::cat({o.flatten(-2), g.to(o.scalar_type())}, -1);
@@ -192,7 +194,8 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
       const int64_t rows = s.object_features.size(0);
       std::vector<double> row_weight(static_cast<std::size_t>(rows), 0.0);  // frames sharing an O row
       const int32_t* row_of = s.feature_row.data_ptr<int32_t>();
-      for (int64_t f = 0; f < frames; ++f) row_weight[static_cast<std::size_t>(row_of[f])] += weight[static_cast<std::size_t>(f)];
+      for (int64_t f = 0; f < frames; ++f)
+        row_weight[static_cast<std::size_t>(row_of[f])] += weight[static_cast<std::size_t>(f)];
       p.o = moments_of(s.object_rows(), rows, kObjectRow, row_weight.data());
       const int64_t g_count = static_cast<int64_t>(g_rows.size() / 7);
       const std::vector<double> ones(static_cast<std::size_t>(g_count), 1.0);
@@ -219,12 +222,9 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
 }
 
 void save_normalization(const NormalizationStats& stats, const std::string& path) {
-  const std::pair<const at::Tensor*, int64_t> checks[] = {{&stats.x_mean, kHandFeatureSize},
-                                                          {&stats.x_std, kHandFeatureSize},
-                                                          {&stats.obj_mean, kObjectConditionSize},
-                                                          {&stats.obj_std, kObjectConditionSize},
-                                                          {&stats.c_mean, 2 * kBasisRows},
-                                                          {&stats.c_std, 2 * kBasisRows}};
+  const std::pair<const at::Tensor*, int64_t> checks[] = {
+      {&stats.x_mean, kHandFeatureSize},      {&stats.x_std, kHandFeatureSize}, {&stats.obj_mean, kObjectConditionSize},
+      {&stats.obj_std, kObjectConditionSize}, {&stats.c_mean, 2 * kBasisRows},  {&stats.c_std, 2 * kBasisRows}};
   for (const auto& [t, size] : checks)
     if (!t->defined() || t->dim() != 1 || t->size(0) != size)
       throw Error(path + ": normalisation statistics have a vector of shape " + shape_str(*t) + ", expected [" +

@@ -27,8 +27,8 @@ constexpr double kNormalizationStdFloor = 1e-3;
 constexpr int kObjectConditionSize = 1024 * 3 + 7;  // [O | G] per frame
 
 struct NormalizationStats {
-  std::string variant;      // encoder variant of O, e.g. "np_bps"
-  std::int64_t count = 0;   // (window, frame) pairs the statistics were taken over
+  std::string variant;     // encoder variant of O, e.g. "np_bps"
+  std::int64_t count = 0;  // (window, frame) pairs the statistics were taken over
   double std_floor = kNormalizationStdFloor;
   // float64; std already floored.
   at::Tensor x_mean, x_std;      // [1200]

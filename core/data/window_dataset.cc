@@ -46,7 +46,6 @@ constexpr int kContactRow = 2 * kBasisRows;        // C numbers per frame
 constexpr const char kCacheMagic[9] = "BMFEAT01";  // 8 bytes, then the header length
 constexpr int kCacheVersion = 1;
 
-
 // FNV-1a, 64 bit: fingerprints of the inputs a cached feature file depends on.
 struct Fnv {
   std::uint64_t h = 1469598103934665603ull;
@@ -56,7 +55,9 @@ struct Fnv {
   }
   void add(const std::string& s) { add(s.data(), s.size() + 1); }
   template <class T>
-  void add_value(T v) { add(&v, sizeof v); }
+  void add_value(T v) {
+    add(&v, sizeof v);
+  }
   std::string hex() const {
     char buf[17];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
@@ -138,7 +139,6 @@ class ObjectStore {
     std::call_once(slot->once, [&] { slot->object = std::make_shared<ArticulatedObject>(load_object(path)); });
     return slot->object;
   }
-  std::size_t size() const { return slots_.size(); }
 
  private:
   struct Slot {
@@ -185,8 +185,9 @@ DatasetSequence compute_sequence(const std::string& path, ObjectStore& objects, 
   const std::vector<int>& ids = hand_info().keypoints;
   const int max_id = *std::max_element(ids.begin(), ids.end());
   if (hv.size(2) <= max_id)
-    throw Error("hand_vertices has " + std::to_string(hv.size(2)) + " vertices per hand; the hand model's keypoints need " +
-                std::to_string(max_id + 1) + " (store full meshes, or no vertices so that the hands are posed)");
+    throw Error("hand_vertices has " + std::to_string(hv.size(2)) +
+                " vertices per hand; the hand model's keypoints need " + std::to_string(max_id + 1) +
+                " (store full meshes, or no vertices so that the hands are posed)");
   const at::Tensor X = hand_features(hv, ids, *object, states);
   const at::Tensor hit_points = canonical_to_world_points(basis_hit_points(*object, states, enc.hit_indices), states);
   const at::Tensor C = contact_maps(hit_points, hv).to(at::kFloat);
@@ -261,7 +262,7 @@ json cache_header(const DatasetSequence& d, const Inputs& in, const SourceStamp&
 }
 
 std::vector<const at::Tensor*> cache_tensors(const DatasetSequence& d) {
-  return {&d.states,        &d.feature_row, &d.object_template, &d.hit_template, &d.dynamic_rows,
+  return {&d.states,          &d.feature_row, &d.object_template, &d.hit_template, &d.dynamic_rows,
           &d.object_features, &d.hit_indices, &d.contact_maps,    &d.hand_features};
 }
 
@@ -386,7 +387,8 @@ BpsVariant parse_bps_variant(const std::string& name) {
   for (BpsVariant v : {BpsVariant::PerPart, BpsVariant::PartAgnostic, BpsVariant::Uniform})
     if (bps_variant_name(v) == name) return v;
   const std::vector<std::string> known{"np_bps", "npa_bps", "u_bps"};
-  throw Error("unknown encoder variant '" + name + "'" + did_you_mean(name, known) + " (known: " + join(known, ", ") + ")");
+  throw Error("unknown encoder variant '" + name + "'" + did_you_mean(name, known) + " (known: " + join(known, ", ") +
+              ")");
 }
 
 std::vector<std::int32_t> window_starts(std::int64_t frames, int window, int stride) {
@@ -427,14 +429,13 @@ WindowDataset WindowDataset::open(const std::string& folder, const std::string& 
     throw Error((fs::path(folder) / "manifest.json").string() + ": the \"" + split + "\" split lists no sequences");
   std::string cache_dir;
   if (options.cache)
-    cache_dir = options.cache_dir.empty()
-                    ? (fs::path(folder) / "cache" / bps_variant_name(options.variant)).string()
-                    : options.cache_dir;
+    cache_dir = options.cache_dir.empty() ? (fs::path(folder) / "cache" / bps_variant_name(options.variant)).string()
+                                          : options.cache_dir;
   WindowDataset ds = load(files, folder, cache_dir, options);
   for (const DatasetSequence& s : ds.sequences_)
     if (std::abs(s.fps - m.fps) > 1e-6 * m.fps) {
-      log::warn("{}: {} fps, but the data set's manifest says {} fps; windows count frames, not seconds", s.path,
-                s.fps, m.fps);
+      log::warn("{}: {} fps, but the data set's manifest says {} fps; windows count frames, not seconds", s.path, s.fps,
+                m.fps);
       break;
     }
   return ds;
@@ -448,13 +449,16 @@ WindowDataset WindowDataset::from_files(const std::vector<std::string>& files, c
 WindowDataset WindowDataset::load(const std::vector<std::string>& files, const std::string& cache_base,
                                   const std::string& cache_dir, const WindowDatasetOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (options.window < 1) throw Error("window data set: window must be >= 1 frame, got " + std::to_string(options.window));
-  if (options.stride < 1) throw Error("window data set: stride must be >= 1 frame, got " + std::to_string(options.stride));
+  if (options.window < 1)
+    throw Error("window data set: window must be >= 1 frame, got " + std::to_string(options.window));
+  if (options.stride < 1)
+    throw Error("window data set: stride must be >= 1 frame, got " + std::to_string(options.stride));
   WindowDataset ds;
   ds.window_ = options.window;
   ds.stride_ = options.stride;
   ds.variant_ = options.variant;
-  ds.basis_file_ = options.basis_file.empty() ? find_data_file(default_basis_file(options.variant)) : options.basis_file;
+  ds.basis_file_ =
+      options.basis_file.empty() ? find_data_file(default_basis_file(options.variant)) : options.basis_file;
   ds.basis_ = load_bps_basis(ds.basis_file_);
   if (ds.basis_.points.rows() != basis_size(options.variant))
     throw Error(ds.basis_file_ + ": the basis has " + std::to_string(ds.basis_.points.rows()) + " points; " +
@@ -503,8 +507,8 @@ WindowDataset WindowDataset::load(const std::vector<std::string>& files, const s
       if (options.progress) options.progress(done, n);
     }
   };
-  const int64_t workers = std::min<int64_t>(options.threads > 0 ? options.threads : at::get_num_threads(),
-                                            static_cast<int64_t>(n));
+  const int64_t workers =
+      std::min<int64_t>(options.threads > 0 ? options.threads : at::get_num_threads(), static_cast<int64_t>(n));
   if (workers <= 1) {
     work();
   } else {
@@ -537,9 +541,9 @@ WindowDataset WindowDataset::load(const std::vector<std::string>& files, const s
   ds.report_.cached = static_cast<std::size_t>(std::count(from_cache.begin(), from_cache.end(), 1));
   ds.report_.computed = n - ds.report_.cached;
   ds.report_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  log::info("data: {} sequences ({} computed, {} cached) in {:.1f} s: {} frames, {} windows of {}, features {}",
-            n, ds.report_.computed, ds.report_.cached, ds.report_.seconds, ds.num_frames(), ds.windows_.size(),
-            ds.window_, human_bytes(static_cast<double>(ds.memory_bytes())));
+  log::info("data: {} sequences ({} computed, {} cached) in {:.1f} s: {} frames, {} windows of {}, features {}", n,
+            ds.report_.computed, ds.report_.cached, ds.report_.seconds, ds.num_frames(), ds.windows_.size(), ds.window_,
+            human_bytes(static_cast<double>(ds.memory_bytes())));
   return ds;
 }
 

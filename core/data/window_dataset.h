@@ -48,10 +48,11 @@ struct WindowDatasetOptions {
   // Per-sequence feature cache on disk (WindowDataset::open only, unless cache_dir is set).
   bool cache = true;
   std::string cache_dir;  // "" = FOLDER/cache/<variant>
-  // Sequences processed at once; 0 = libtorch's intra-op thread count (--threads).
+  // Sequences processed at once, on plain threads that each run libtorch single-threaded;
+  // 0 = libtorch's intra-op thread count (--threads).
   int threads = 0;
   // Called after each sequence with (done, total); calls are serialised but may come from
-  // worker threads.
+  // worker threads, and must not throw.
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
@@ -74,22 +75,22 @@ struct WindowBatch {
 // that are the same in every frame of the sequence (for NP-BPS the whole bottom half) are
 // stored once in the templates, the others (`dynamic_rows`) per row.
 struct DatasetSequence {
-  std::string path;         // the sequence file
+  std::string path;  // the sequence file
   std::string name, category, kind;
   std::string object_path;  // resolved (core/io/sequence.h, resolve_object_path)
   double fps = 30;
-  double scale = 1;         // s_o
-  std::int64_t frames = 0;  // N
-  at::Tensor states;           // [N, 7] float32
-  at::Tensor feature_row;      // [N] int32, in [0, U)
-  at::Tensor object_template;  // [1024, 3] float16 (float32 without half_precision): row 0's O
-  at::Tensor hit_template;     // [1024] int16 (int32 for objects of >= 32768 vertices)
-  at::Tensor dynamic_rows;     // [D] int32: the basis rows that change, ascending
-  at::Tensor object_features;  // [U, D, 3] O of the dynamic rows
-  at::Tensor hit_indices;      // [U, D]
-  at::Tensor contact_maps;     // [N, 2, 1024] float16 / float32
-  at::Tensor hand_features;    // [N, 1200] float16 / float32
-  std::size_t bytes() const;   // memory held by the tensors above
+  double scale = 1;                // s_o
+  std::int64_t frames = 0;         // N
+  at::Tensor states;               // [N, 7] float32
+  at::Tensor feature_row;          // [N] int32, in [0, U)
+  at::Tensor object_template;      // [1024, 3] float16 (float32 without half_precision): row 0's O
+  at::Tensor hit_template;         // [1024] int16 (int32 for objects of >= 32768 vertices)
+  at::Tensor dynamic_rows;         // [D] int32: the basis rows that change, ascending
+  at::Tensor object_features;      // [U, D, 3] O of the dynamic rows
+  at::Tensor hit_indices;          // [U, D]
+  at::Tensor contact_maps;         // [N, 2, 1024] float16 / float32
+  at::Tensor hand_features;        // [N, 1200] float16 / float32
+  std::size_t bytes() const;       // memory held by the tensors above
   at::Tensor object_rows() const;  // [U, 1024, 3] float32: every basis row, rebuilt
   at::Tensor hit_rows() const;     // [U, 1024] int64
 };
@@ -111,13 +112,12 @@ class WindowDataset {
   static WindowDataset open(const std::string& folder, const std::string& split,
                             const WindowDatasetOptions& options = {});
   // Explicit sequence files (no manifest); cached only when options.cache_dir is set.
-  static WindowDataset from_files(const std::vector<std::string>& files,
-                                  const WindowDatasetOptions& options = {});
+  static WindowDataset from_files(const std::vector<std::string>& files, const WindowDatasetOptions& options = {});
 
   std::size_t size() const { return windows_.size(); }  // windows
   const std::vector<WindowRef>& windows() const { return windows_; }
   const std::vector<DatasetSequence>& sequences() const { return sequences_; }
-  std::int64_t num_frames() const;  // frames of all sequences (without padding)
+  std::int64_t num_frames() const;   // frames of all sequences (without padding)
   std::size_t memory_bytes() const;  // all sequences' features
   int window() const { return window_; }
   int stride() const { return stride_; }

@@ -68,7 +68,7 @@ void prepare_folder(const SynthOptions& o) {
       throw Error(o.out + ": not empty; choose another folder or pass --force to replace the data set in it");
     if (!fs::exists(fs::path(o.out) / "manifest.json") && !fs::exists(fs::path(o.out) / "sequences"))
       throw Error(o.out + ": not a bimart data set (no manifest.json or sequences/); refusing to replace it");
-    for (const char* sub : {"manifest.json", "sequences", "objects", "preview"}) fs::remove_all(fs::path(o.out) / sub);
+    for (const char* sub : {"manifest.json", "sequences", "objects", "preview", "cache"}) fs::remove_all(fs::path(o.out) / sub);
   }
   fs::create_directories(fs::path(o.out) / "sequences");
   fs::create_directories(fs::path(o.out) / "objects");
@@ -169,8 +169,16 @@ SynthSummary synthesize_dataset(const SynthOptions& o) {
       SequenceJob& j = jobs[i];
       const ObjectJob& obj = objects[j.object];
       std::string why;
-      for (int retry = 0; retry < 4 && !j.written; ++retry) {
+      // A new trajectory on each retry; the last ones switch between grab and use, so that
+      // an object whose use is hard to plan (a small flip phone) still gets its sequences.
+      const SequenceKind planned = j.kind;
+      for (int retry = 0; retry < 5 && !j.written; ++retry) {
         const std::uint64_t s = derive(j.seed, static_cast<std::uint64_t>(retry));
+        if (retry == 3) {
+          j.kind = planned == SequenceKind::Grab ? SequenceKind::Use : SequenceKind::Grab;
+          j.name = fmt::format("{}_{}_{:02d}", obj.name, kind_name(j.kind), j.index);
+          j.file = "sequences/" + j.name + ".npz";
+        }
         const Trajectory tr = plan_trajectory(*obj.object, j.kind, derive(s, 1), o.trajectory);
         try {
           Sequence seq;

@@ -19,7 +19,7 @@ struct SynthOptions {
   std::vector<std::string> categories;  // empty = every procedural category
   int train_objects = 5;                // object instances per category in the train split
   int test_objects = 1;                 // ... and in the test split
-  int sequences_per_object = 11;        // alternating grab and use
+  int sequences_per_object = 13;        // alternating grab and use
   std::uint64_t seed = 1;
   int threads = 0;                      // 0 = all cores
   bool progress = true;

@@ -4,11 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "core/geometry/rotation.h"
 #include "core/hand/lbs.h"
 #include "core/hand/procedural_hand.h"
 #include "core/object/object_state.h"
 #include "core/util/error.h"
+#include "core/util/log.h"
 
 namespace bimart {
 namespace {
@@ -108,11 +111,15 @@ bool GraspPlanner::deeper_than(ObjectPart part, double angle, const Points3& poi
 }
 
 std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const GraspRequest& req, int vertex,
-                                            double wrist_angle, Rng& rng) const {
+                                            double wrist_angle, Rng& rng, RejectCounts& counts) const {
+  const auto reject = [&](Reject why) -> std::optional<Grasp> {
+    ++counts[static_cast<size_t>(why)];
+    return std::nullopt;
+  };
   const PartSurface& surf = surface(req.part);
   const Eigen::Vector3d site = surf.mesh->vertices.row(vertex).transpose();
   const Eigen::Vector3d normal = surf.normals.row(vertex).transpose();
-  if (normal.squaredNorm() < 0.5) return std::nullopt;
+  if (normal.squaredNorm() < 0.5) return reject(Reject::Normal);
 
   // Orientation: the palm faces into the surface, the fingers along a tangent at the wrist angle.
   Eigen::Vector3d t0 = normal.unitOrthogonal();
@@ -123,7 +130,7 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = part * local.transpose();
   const Eigen::Matrix3d world_rotation = req.world_from_part.linear() * T.linear();
-  if (req.accept_wrist && !req.accept_wrist(world_rotation, req.world_from_part * site)) return std::nullopt;
+  if (req.accept_wrist && !req.accept_wrist(world_rotation, req.world_from_part * site)) return reject(Reject::Wrist);
 
   // Palm against the surface with the digits straight: bisect the offset along the normal
   // for the deepest vertex to sit at kTouch.
@@ -133,6 +140,7 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   g.normal = normal;
   g.spread = rng.uniform(-0.05, 0.12);
   g.curl = {0, 0, 0, 0, rng.uniform(0.0, 0.3)};
+  g.start_curl = g.curl;
   Points3 local_v = local_hand_vertices(hand, grasp_finger_pose(hand, g.curl, g.spread));
   // Deeper than `threshold` into the object or below the table.
   const Eigen::Isometry3d& W = req.world_from_part;
@@ -141,7 +149,9 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
     if (table)
       for (Eigen::Index i = 0; i < pts.rows(); ++i)
         if (req.table_height - (W * pts.row(i).transpose()).y() > threshold) return true;
-    return deeper_than(req.part, req.angle, pts, threshold);
+    if (deeper_than(req.part, req.angle, pts, threshold)) return true;
+    return std::isfinite(req.release_angle) && req.release_angle != req.angle &&
+           deeper_than(req.part, req.release_angle, pts, threshold);
   };
   auto place = [&](double offset) {
     Eigen::Isometry3d P = T;
@@ -155,14 +165,17 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   for (Eigen::Index i = 0; i < coarse.rows(); ++i) coarse.row(i) = local_v.row(2 * i);
   // The palm must touch its own part: the other part and the table may only stop it short.
   const MeshDistance& own = req.part == ObjectPart::Top ? distance_.top() : distance_.bottom();
-  if (blocked(transformed(place(hi), coarse), kTouch)) return std::nullopt;  // obstructed
-  if (!own.any_deeper_than(transformed(place(lo), coarse), kTouch)) return std::nullopt;
+  // Start from a clear pose: 6 cm off the surface, or closer where the table or the other
+  // part leaves less room (under an object on a stand).
+  while (blocked(transformed(place(hi), coarse), kTouch))
+    if ((hi *= 0.5) < 0.007) return reject(Reject::Obstructed);
+  if (!own.any_deeper_than(transformed(place(lo), coarse), kTouch)) return reject(Reject::Obstructed);
   for (int it = 0; it < 10; ++it) {  // 9 cm / 2^10: 0.1 mm
     const double mid = 0.5 * (lo + hi);
     (blocked(transformed(place(mid), coarse), kTouch) ? lo : hi) = mid;
   }
   T = place(hi);
-  if (own.max_signed_distance(transformed(T, coarse)) < -kContact) return std::nullopt;  // held off its part
+  if (own.max_signed_distance(transformed(T, coarse)) < -kContact) return reject(Reject::HeldOff);
 
   // Close the digits together until each one touches (or reaches its rest curl in the air).
   const std::array<double, 5> limit{1.0, 1.0, 1.0, 1.0, 1.0};
@@ -182,7 +195,7 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
     const std::array<bool, 5> all{true, true, true, true, true};
     const auto b0 = digits_blocked(ok, all);
     for (int c = 0; c < 5; ++c)
-      if (b0[c]) return std::nullopt;  // a straight digit already penetrates
+      if (b0[c]) return reject(Reject::Digit);  // a straight digit already penetrates
   }
   constexpr double kStep = 0.1;
   for (int step = 0; step < 11; ++step) {
@@ -223,13 +236,13 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   const Eigen::VectorXd sd = own.signed_distances(v);
   g.depth = std::max(sd.maxCoeff(), depth_other(req.part, req.angle, v));
   g.contacts = static_cast<int>((sd.array() > -kContact).count());
-  if (g.depth > req.max_depth || blocked(v, req.max_depth) || g.contacts < 5) return std::nullopt;
+  if (g.depth > req.max_depth || blocked(v, req.max_depth) || g.contacts < 5) return reject(Reject::Final);
   for (double a : req.hold_angles) {  // the other part must not move into the hand
     const Eigen::Isometry3d rel = req.part == ObjectPart::Top ? top_to_canonical(a) : top_to_canonical(a).inverse();
     const MeshDistance& other = req.part == ObjectPart::Top ? distance_.bottom() : distance_.top();
-    if (other.any_deeper_than(transformed(rel, v), req.max_depth)) return std::nullopt;
+    if (other.any_deeper_than(transformed(rel, v), req.max_depth)) return reject(Reject::Hinge);
   }
-  if (req.accept_hand && !req.accept_hand(v)) return std::nullopt;
+  if (req.accept_hand && !req.accept_hand(v)) return reject(Reject::OtherHand);
   return g;
 }
 
@@ -238,21 +251,36 @@ std::optional<Grasp> GraspPlanner::plan(const HandGeometry& hand, const GraspReq
   const PartSurface& surf = surface(req.part);
   const int n = static_cast<int>(surf.mesh->num_vertices());
   std::vector<Grasp> found;
-  for (int attempt = 0; attempt < req.max_tries && static_cast<int>(found.size()) < req.candidates; ++attempt) {
-    const int v = std::min(n - 1, static_cast<int>(rng.uniform() * n));
+  RejectCounts counts{};
+  // The sites the filter accepts, then tries among those only.
+  std::vector<int> sites;
+  for (int v = 0; v < n; ++v) {
     const Eigen::Vector3d site = surf.mesh->vertices.row(v).transpose();
     const Eigen::Vector3d normal = surf.normals.row(v).transpose();
-    if (req.accept_site && !req.accept_site(site, normal)) continue;
+    if (!req.accept_site || req.accept_site(site, normal)) sites.push_back(v);
+    else ++counts[static_cast<size_t>(Reject::Site)];
+  }
+  for (int attempt = 0; !sites.empty() && attempt < req.max_tries && static_cast<int>(found.size()) < req.candidates;
+       ++attempt) {
+    const int v = sites[std::min(sites.size() - 1, static_cast<size_t>(rng.uniform() * static_cast<double>(sites.size())))];
     // A few wrist angles at this site, in random order; the first that works.
     const double start = rng.uniform(0, 2 * M_PI);
     for (int k = 0; k < 6; ++k) {
-      if (auto g = try_site(hand, req, v, start + k * (M_PI / 3), rng)) {
+      if (auto g = try_site(hand, req, v, start + k * (M_PI / 3), rng, counts)) {
         found.push_back(*g);
         break;
       }
     }
   }
-  if (found.empty()) return std::nullopt;
+  if (found.empty()) {
+    static const char* kNames[] = {"site", "normal", "wrist", "obstructed", "held off", "digit", "final",
+                                   "hinge", "other hand"};
+    std::string text;
+    for (size_t i = 0; i < counts.size(); ++i)
+      if (counts[i]) text += fmt::format(" {} {}", kNames[i], counts[i]);
+    log::debug("grasp planner: no grasp on the {} part; rejected:{}", req.part == ObjectPart::Top ? "top" : "bottom", text);
+    return std::nullopt;
+  }
   // More contact is a firmer grasp; the jitter keeps the choice varied.
   size_t best = 0;
   double best_score = -1;

@@ -49,6 +49,7 @@ struct Grasp {
   Eigen::Isometry3d part_from_hand = Eigen::Isometry3d::Identity();
   Eigen::VectorXd finger_pose;           // 45, flat
   std::array<double, 5> curl{};
+  std::array<double, 5> start_curl{};  // where closing began: curls between it and `curl` are clear
   double spread = 0;
   Eigen::Vector3d site = Eigen::Vector3d::Zero();    // contact site, part frame
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY(); // outward normal there, part frame
@@ -70,6 +71,9 @@ struct GraspRequest {
   // Hinge angles the grasp must also be clear of the other part at (the angles it passes
   // through while held); the grasp angle itself is always checked.
   std::vector<double> hold_angles;
+  // The hinge angle when the hand lets go (NaN: the grasp angle): the digits open there, so
+  // their whole closing path must be clear of the other part at that angle too.
+  double release_angle = std::numeric_limits<double>::quiet_NaN();
   // Optional last check of a finished grasp: its hand vertices in the part's frame.
   std::function<bool(const Points3& vertices)> accept_hand;
   double max_depth = 0.002;  // no vertex deeper than this (m)
@@ -102,8 +106,11 @@ class GraspPlanner {
   const ArticulatedObject& object() const { return object_; }
 
  private:
+  // Why candidates fail, counted for the debug log.
+  enum class Reject { Site, Normal, Wrist, Obstructed, HeldOff, Digit, Final, Hinge, OtherHand, Count };
+  using RejectCounts = std::array<int, static_cast<size_t>(Reject::Count)>;
   std::optional<Grasp> try_site(const HandGeometry& hand, const GraspRequest& request, int vertex,
-                                double wrist_angle, Rng& rng) const;
+                                double wrist_angle, Rng& rng, RejectCounts& counts) const;
   const ArticulatedObject& object_;
   const ObjectDistance& distance_;
   PartSurface top_, bottom_;

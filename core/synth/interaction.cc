@@ -9,6 +9,7 @@
 #include "core/geometry/nearest_points.h"
 #include "core/geometry/rotation.h"
 #include "core/synth/grasp.h"
+#include "core/synth/motion_table.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/random.h"
@@ -22,11 +23,17 @@ Eigen::Vector3d shoulder(int hand, const Eigen::Vector3d& centre) {
   return Eigen::Vector3d(centre.x() + (hand == 0 ? -0.20 : 0.20), 0.40, centre.z() + 0.45);
 }
 
-Eigen::Isometry3d interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double s) {
+// Between two hand poses: the rotation slerped about `pivot` (hand local; the palm centre),
+// which moves on a straight line, so the palm leaves the surface along the approach line
+// instead of swinging through it. The rotation follows its own profile `s_rotation`
+// (turned while away from the object, not at it).
+Eigen::Isometry3d interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double s,
+                              const Eigen::Vector3d& pivot, double s_rotation) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   const Eigen::Quaterniond qa(a.linear()), qb(b.linear());
-  T.linear() = qa.slerp(s, qb).toRotationMatrix();
-  T.translation() = a.translation() + s * (b.translation() - a.translation());
+  T.linear() = qa.slerp(s_rotation, qb).toRotationMatrix();
+  const Eigen::Vector3d pa = a * pivot, pb = b * pivot;
+  T.translation() = pa + s * (pb - pa) - T.linear() * pivot;
   return T;
 }
 
@@ -74,14 +81,16 @@ Motion build_motion(const Trajectory& tr, const std::array<HandPlan, 2>& plans,
         T = p.pre, fingers = p.open_before;
       } else if (f < p.grasp_frame) {
         const double u = static_cast<double>(f - p.start) / (p.grasp_frame - p.start);
-        T = interpolate(p.pre, at_grasp, min_jerk(u));
-        fingers = p.open_before + min_jerk((u - 0.35) / 0.65) * (p.grasp.finger_pose - p.open_before);
+        // Reach (turned on the way), then close the fingers on the surface.
+        T = interpolate(p.pre, at_grasp, min_jerk(u / 0.7), geo[h].palm_point, min_jerk(u / 0.5));
+        fingers = p.open_before + min_jerk((u - 0.55) / 0.45) * (p.grasp.finger_pose - p.open_before);
       } else if (f <= p.release_frame) {
         T = hold_pose(f), fingers = p.grasp.finger_pose, holding = true;
       } else if (f < p.end) {
         const double u = static_cast<double>(f - p.release_frame) / (p.end - p.release_frame);
-        T = interpolate(at_release, p.post, min_jerk(u));
-        fingers = p.grasp.finger_pose + min_jerk(u / 0.6) * (p.open_after - p.grasp.finger_pose);
+        // Open the fingers first (a hooked finger must let go), then leave.
+        T = interpolate(at_release, p.post, min_jerk((u - 0.3) / 0.7), geo[h].palm_point, min_jerk((u - 0.5) / 0.5));
+        fingers = p.grasp.finger_pose + min_jerk(u / 0.4) * (p.open_after - p.grasp.finger_pose);
       } else {
         T = p.post, fingers = p.open_after;
       }
@@ -110,7 +119,8 @@ std::string check_motion(const Trajectory& tr, const ObjectDistance& distance, c
       const double d = distance.max_signed_distance(tr.states[f], v);
       *deepest = std::max(*deepest, d);
       if (d > (holding ? o.max_depth + 0.001 : o.max_depth_moving))
-        return "hand " + std::to_string(h) + " is " + std::to_string(1000 * d) + " mm deep at frame " + std::to_string(f);
+        return "hand " + std::to_string(h) + " is " + std::to_string(1000 * d) + " mm deep at frame " +
+               std::to_string(f) + (holding ? " (holding)" : f < plans[h].grasp_frame ? " (approaching)" : " (leaving)");
     }
     const NearestPoints left(m.vertices[0][f]);
     const Points3& right = m.vertices[1][f];
@@ -155,6 +165,9 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
   for (Eigen::Index i = 0; i < object.top.num_vertices(); ++i)
     top_reach = std::max(top_reach, object.top.vertices.row(i).head<2>().norm());
 
+  // On a stand there is room for a hand underneath (core/synth/motion_table.h).
+  const bool on_stand = category_motion(object.category).support >= 0.04;
+  const int preferred_driver = rng.chance(0.5) ? 0 : 1;
   std::string last_reason = "no grasp found";
   for (int attempt = 1; attempt <= o.attempts; ++attempt) {
     Rng r(rng.next_seed());
@@ -166,7 +179,9 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
     int driver = -1;
     std::array<ObjectPart, 2> part{ObjectPart::Bottom, ObjectPart::Bottom};
     if (tr.kind == SequenceKind::Use) {
-      driver = r.chance(0.5) ? 0 : 1;
+      // The seed picks the driving hand; only the last attempt tries the other one, so
+      // that a hand that is easier to plan for does not win most sequences.
+      driver = attempt < o.attempts ? preferred_driver : 1 - preferred_driver;
       part[driver] = ObjectPart::Top;
     }
     const int first_hand = driver >= 0 ? driver : (r.chance(0.5) ? 0 : 1);
@@ -187,13 +202,15 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
       req.world_from_part = world_from_part(s, part[h]);
       req.max_depth = o.max_depth;
       req.table_height = o.table_clearance + 0.001;  // the object rests on the table when grasped
+      req.release_angle = tr.states[static_cast<size_t>(plans[h].release_frame)].angle;
       {  // the hinge angles passed while held: the range, evenly
         double a_lo = s.angle, a_hi = s.angle;
         for (int f = plans[h].grasp_frame; f <= plans[h].release_frame; ++f)
           a_lo = std::min(a_lo, tr.states[static_cast<size_t>(f)].angle),
           a_hi = std::max(a_hi, tr.states[static_cast<size_t>(f)].angle);
-        if (a_hi > a_lo)
-          for (int k = 0; k <= 12; ++k) req.hold_angles.push_back(a_lo + (a_hi - a_lo) * k / 12.0);
+        // Steps small enough that the top part's far end moves at most 4 mm between them.
+        const int steps = std::min(90, static_cast<int>(std::ceil((a_hi - a_lo) * top_reach / 0.004)));
+        for (int k = 0; k <= steps && a_hi > a_lo; ++k) req.hold_angles.push_back(a_lo + (a_hi - a_lo) * k / steps);
       }
       const bool second = h != first_hand;
       const Grasp* other = second ? &plans[first_hand].grasp : nullptr;
@@ -202,9 +219,13 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
       req.accept_site = [&, h, second, other, W_other, relaxed](const Eigen::Vector3d& site, const Eigen::Vector3d& nrm) {
         const Eigen::Isometry3d& W = req.world_from_part;
         const Eigen::Vector3d pw = W * site, nw = W.linear() * nrm;
-        if (nw.y() < -0.3) return false;  // under the object (the table check does the rest)
+        if (nw.y() < -0.3 && !on_stand) return false;  // under the object (the table check does the rest)
         if (part[h] == ObjectPart::Top && site.head<2>().norm() < 0.55 * top_reach) return false;
-        if (!relaxed && (h == 0 ? pw.x() - centre.x() > 0.3 * half_x : centre.x() - pw.x() > 0.3 * half_x)) return false;
+        // Each hand keeps to its side; the driver may reach across (a door's free edge is
+        // on one side, and either hand opens it).
+        if (!relaxed && h != driver &&
+            (h == 0 ? pw.x() - centre.x() > 0.3 * half_x : centre.x() - pw.x() > 0.3 * half_x))
+          return false;
         if (second) {
           const Eigen::Vector3d po = W_other * other->site, no = W_other.linear() * other->normal;
           if ((pw - po).norm() < (relaxed ? 0.05 : 0.07)) return false;
@@ -214,8 +235,9 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
       };
       const Eigen::Vector3d sh = shoulder(h, centre);
       const Eigen::Vector3d finger_dir = geo[h].finger_dir;
-      req.accept_wrist = [sh, finger_dir](const Eigen::Matrix3d& R, const Eigen::Vector3d& pw) {
-        return (R * -finger_dir).dot((sh - pw).normalized()) > 0.2;
+      const double reach = relaxed ? -0.1 : 0.2;  // how squarely the forearm must point at the shoulder
+      req.accept_wrist = [sh, finger_dir, reach](const Eigen::Matrix3d& R, const Eigen::Vector3d& pw) {
+        return (R * -finger_dir).dot((sh - pw).normalized()) > reach;
       };
       if (second) {  // clear of the first hand at every angle passed while both hold
         const HandPlan& q = plans[first_hand];
@@ -275,19 +297,35 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
           Eigen::Vector3d apart = T.translation() - hold(f, 1 - h).translation();
           apart.y() = 0;
           if (apart.norm() > 1e-6) apart.normalize();
-          const Eigen::Vector3d dir =
-              (nw + 0.6 * Eigen::Vector3d::UnitY() + 0.5 * to_shoulder + (0.4 + 0.3 * draw) * apart).normalized();
+          // Off the surface; from under an object (on a stand) sideways, never down into the table.
+          Eigen::Vector3d off = nw;
+          if (off.y() < 0) {
+            off.y() = 0;
+            if (off.norm() < 0.3) off = Eigen::Vector3d(to_shoulder.x(), 0, to_shoulder.z());
+            off.normalize();
+          }
+          Eigen::Vector3d dir =
+              (off + 0.6 * Eigen::Vector3d::UnitY() + 0.5 * to_shoulder + (0.4 + 0.3 * draw) * apart).normalized();
+          // Mostly off the surface: at least 50° from sliding along it.
+          for (int k = 0; k < 8 && dir.dot(off) < 0.65; ++k) dir = (dir + 0.5 * off).normalized();
+          // Turned a little about the palm centre, then moved away along `dir`.
           Eigen::Isometry3d A = T;
-          A.linear() = rotation_about(random_axis(r), r.uniform(0.1, 0.4)) * T.linear();
-          A.translation() = T.translation() + r.uniform(0.10, 0.25) * dir;
+          A.linear() = rotation_about(random_axis(r), r.uniform(0.05, 0.3)) * T.linear();
+          const Eigen::Vector3d palm = T * geo[h].palm_point;
+          A.translation() = palm + r.uniform(0.10, 0.25) * dir - A.linear() * geo[h].palm_point;
           return A;
         };
         p.pre = away(p.grasp_frame);
         p.post = away(p.release_frame);
+        // Open: on the planner's closing path (checked clear), so opening only lifts the
+        // digits off the surface and closing only brings them onto it.
         const auto open = [&] {
           std::array<double, 5> c{};
-          for (int k = 0; k < 5; ++k) c[k] = r.uniform(0.05, 0.3);
-          return grasp_finger_pose(geo[h], c, r.uniform(0.0, 0.15));
+          for (int k = 0; k < 5; ++k) {
+            const double a = p.grasp.start_curl[k], b = std::max(a, p.grasp.curl[k]);
+            c[k] = a + r.uniform(0.0, 0.5) * (b - a);
+          }
+          return grasp_finger_pose(geo[h], c, p.grasp.spread);
         };
         p.open_before = open();
         p.open_after = open();

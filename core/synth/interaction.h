@@ -19,10 +19,10 @@ namespace bimart {
 
 struct InteractionOptions {
   double max_depth = 0.002;       // no hand vertex deeper inside the object while holding (m)
-  double max_depth_moving = 0.004;  // ... nor during approach and release
-  double hand_clearance = 0.006;  // minimum distance between the two hands' vertices (m)
+  double max_depth_moving = 0.0049;  // ... nor during approach and release (below Pen 5mm)
+  double hand_clearance = 0.002;  // minimum distance between the two hands' vertices (m)
   double table_clearance = -0.002;  // lowest hand vertex height allowed (m; the table is y = 0)
-  int attempts = 12;              // full re-plans before giving up
+  int attempts = 6;               // full re-plans before giving up
 };
 
 struct InteractionInfo {

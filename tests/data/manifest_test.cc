@@ -15,8 +15,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The scratch folders of this process, removed when it exits.
+const fs::path& scratch_root() {
+  struct Root {
+    fs::path dir = fs::temp_directory_path() / ("bimart_manifest_tests_" + std::to_string(::getpid()));
+    ~Root() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  static const Root root;
+  return root.dir;
+}
+
 fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("bimart_manifest_tests_" + std::to_string(::getpid())) / name;
+  const fs::path p = scratch_root() / name;
   fs::remove_all(p);
   fs::create_directories(p / "seq");
   fs::create_directories(p / "objects" / "box");

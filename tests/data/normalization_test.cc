@@ -60,7 +60,13 @@ TEST(Normalization, TrainDataIsStandardisedPerFeature) {
   for (const Case& c : cases) {
     const auto [raw_mean, raw_std] = moments(c.raw.index_select(0, valid));
     const auto [mean, std] = moments(c.normalised.index_select(0, valid));
-    EXPECT_LT((raw_mean - (c.what[0] == 'X' ? st.x_mean : c.what[0] == 'C' ? st.c_mean : st.obj_mean)).abs().max().item<double>(), 1e-6)
+    EXPECT_LT((raw_mean - (c.what[0] == 'X'   ? st.x_mean
+                           : c.what[0] == 'C' ? st.c_mean
+                                              : st.obj_mean))
+                  .abs()
+                  .max()
+                  .item<double>(),
+              1e-6)
         << c.what;
     // Features whose std is above the floor come out with std 1; the others (constant on
     // the training data, e.g. the NP-BPS bottom half for one object) with std < 1.
@@ -69,7 +75,8 @@ TEST(Normalization, TrainDataIsStandardisedPerFeature) {
     EXPECT_LT(mean.abs().max().item<double>(), 1e-4) << c.what;
     EXPECT_LT((std.masked_select(varying) - 1).abs().max().item<double>(), 1e-4) << c.what;
     EXPECT_GE(c.std.min().item<double>(), st.std_floor) << c.what;
-    if ((~varying).any().item<bool>()) EXPECT_LE(std.masked_select(~varying).max().item<double>(), 1.0 + 1e-6) << c.what;
+    if ((~varying).any().item<bool>())
+      EXPECT_LE(std.masked_select(~varying).max().item<double>(), 1.0 + 1e-6) << c.what;
     EXPECT_TRUE(at::allclose(raw_std.clamp_min(st.std_floor), c.std, 1e-5, 1e-9)) << c.what;
   }
   // The NP-BPS bottom half and s_o are constant for one object: their std sits at the floor.
@@ -101,9 +108,12 @@ TEST(Normalization, SaveLoadAndErrors) {
   EXPECT_EQ(back.variant, "np_bps");
   EXPECT_EQ(back.count, train_stats().count);
   EXPECT_DOUBLE_EQ(back.std_floor, 1e-3);
-  for (auto [a, b] : {std::pair{&back.x_mean, &train_stats().x_mean}, {&back.x_std, &train_stats().x_std},
-                      {&back.obj_mean, &train_stats().obj_mean}, {&back.obj_std, &train_stats().obj_std},
-                      {&back.c_mean, &train_stats().c_mean}, {&back.c_std, &train_stats().c_std}})
+  for (auto [a, b] : {std::pair{&back.x_mean, &train_stats().x_mean},
+                      {&back.x_std, &train_stats().x_std},
+                      {&back.obj_mean, &train_stats().obj_mean},
+                      {&back.obj_std, &train_stats().obj_std},
+                      {&back.c_mean, &train_stats().c_mean},
+                      {&back.c_std, &train_stats().c_std}})
     EXPECT_TRUE(at::equal(*a, *b));
   const NpzFile f = NpzFile::read(path);
   for (const char* key : {"x_mean", "x_std", "obj_mean", "obj_std", "c_mean", "c_std", "variant", "count"})

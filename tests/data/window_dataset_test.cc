@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include <ATen/ATen.h>
+#include <ATen/Parallel.h>
 
 #include "core/features/contact_map.h"
 #include "core/features/hand_features.h"
@@ -25,7 +26,7 @@ using testing_data::tiny_train;
 namespace fs = std::filesystem;
 
 // float16 storage: round to nearest, 11 significant bits.
-constexpr double kHalfRelative = 1.0 / 2048;   // 2^-11
+constexpr double kHalfRelative = 1.0 / 2048;       // 2^-11
 constexpr double kHalfAbsolute = 1.0 / (1 << 25);  // 2^-25, the subnormal range
 
 // max(|got - exact| - bound(exact)); <= 0 when every entry is within the float16 bound.
@@ -85,8 +86,8 @@ TEST(WindowDataset, WindowsPaddingAndMask) {
   EXPECT_EQ(b.mask[0].slice(0, 0, 40).sum().item<float>(), 40);
   EXPECT_EQ(b.mask[0].slice(0, 40).sum().item<float>(), 0);
   EXPECT_EQ(b.mask[1].sum().item<float>(), 64);
-  for (const at::Tensor* t : {&b.object_features, &b.global_states, &b.contact_maps, &b.hand_features,
-                              &b.hit_indices, &b.object_states}) {
+  for (const at::Tensor* t :
+       {&b.object_features, &b.global_states, &b.contact_maps, &b.hand_features, &b.hit_indices, &b.object_states}) {
     const at::Tensor pad = (*t)[0].slice(0, 40);
     EXPECT_TRUE(at::equal(pad, (*t)[0][39].unsqueeze(0).expand_as(pad)));
   }
@@ -219,7 +220,8 @@ TEST(WindowDataset, Float16StorageErrorIsBounded) {
   const WindowBatch f = full.batch(all_windows(full));
   const WindowBatch h = tiny_train().batch(all_windows(tiny_train()));
   double worst = 0;
-  for (auto [got, exact] : {std::pair{&h.object_features, &f.object_features}, {&h.contact_maps, &f.contact_maps},
+  for (auto [got, exact] : {std::pair{&h.object_features, &f.object_features},
+                            {&h.contact_maps, &f.contact_maps},
                             {&h.hand_features, &f.hand_features}}) {
     EXPECT_LE(excess_over_half_bound(*got, *exact), 0);
     const at::Tensor e = exact->to(at::kDouble), normal = e.abs() > 1e-4;  // float16's normal range
@@ -243,7 +245,7 @@ TEST(WindowDataset, SameSeedSameBatchAndThreadsDoNotMatter) {
   EXPECT_TRUE(at::equal(a.global_states, b.global_states));
   const at::Tensor ka = a.sequence * 1000 + a.start, kc = c.sequence * 1000 + c.start;
   EXPECT_FALSE(at::equal(ka, kc)) << "seeds 7 and 8 drew the same windows";
-  EXPECT_EQ(std::get<0>(at::_unique(ka)).numel(), 3);  // distinct when B <= size
+  EXPECT_EQ(std::get<0>(at::_unique(ka)).numel(), 3);   // distinct when B <= size
   EXPECT_EQ(ds.sample_batch(10, r1).mask.size(0), 10);  // with repetition beyond size
   std::mt19937_64 e1(3), e2(3);
   std::vector<int64_t> order = ds.shuffled(e1);
@@ -255,7 +257,11 @@ TEST(WindowDataset, SameSeedSameBatchAndThreadsDoNotMatter) {
   o.cache = false;
   o.threads = 1;
   const WindowDataset serial = WindowDataset::open(tiny_dataset().dir.string(), "train", o);
-  const WindowBatch x = serial.batch(all_windows(serial)), y = ds.batch(all_windows(ds));
+  o.threads = 2;
+  const int caller_threads = at::get_num_threads();
+  const WindowDataset parallel = WindowDataset::open(tiny_dataset().dir.string(), "train", o);
+  EXPECT_EQ(at::get_num_threads(), caller_threads);  // restored after the workers
+  const WindowBatch x = serial.batch(all_windows(serial)), y = parallel.batch(all_windows(parallel));
   EXPECT_TRUE(at::equal(x.object_features, y.object_features));
   EXPECT_TRUE(at::equal(x.contact_maps, y.contact_maps));
   EXPECT_TRUE(at::equal(x.hand_features, y.hand_features));
@@ -273,9 +279,12 @@ TEST(WindowDataset, DiskCacheIsReusedAndRefreshed) {
   const WindowDataset second = WindowDataset::open(dir.string(), "train", o);
   EXPECT_EQ(second.load_report().cached, 3u);
   const WindowBatch a = first.batch(all_windows(first)), b = second.batch(all_windows(second));
-  for (auto [x, y] : {std::pair{&a.object_features, &b.object_features}, {&a.contact_maps, &b.contact_maps},
-                      {&a.hand_features, &b.hand_features}, {&a.hit_indices, &b.hit_indices},
-                      {&a.global_states, &b.global_states}, {&a.mask, &b.mask}})
+  for (auto [x, y] : {std::pair{&a.object_features, &b.object_features},
+                      {&a.contact_maps, &b.contact_maps},
+                      {&a.hand_features, &b.hand_features},
+                      {&a.hit_indices, &b.hit_indices},
+                      {&a.global_states, &b.global_states},
+                      {&a.mask, &b.mask}})
     EXPECT_TRUE(at::equal(*x, *y));
   EXPECT_EQ(second.sequences()[1].name, "grab_b");
   EXPECT_EQ(second.sequences()[1].kind, "grab");

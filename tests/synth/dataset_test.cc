@@ -33,7 +33,7 @@ class Dataset : public ::testing::Test {
   SynthOptions tiny(const std::string& name, std::uint64_t seed = 4) const {
     SynthOptions o;
     o.out = (root_ / name).string();
-    o.categories = {"phone", "box"};
+    o.categories = {"notebook", "box"};
     o.train_objects = 1;
     o.test_objects = 1;
     o.sequences_per_object = 2;
@@ -90,7 +90,7 @@ TEST_F(Dataset, SameSeedByteIdenticalFilesOtherSeedOtherFiles) {
     EXPECT_NE(bytes_of(fs::path(a.out) / f), bytes_of(fs::path(c.out) / f)) << f;
   }
   EXPECT_EQ(bytes_of(fs::path(a.out) / "manifest.json"), bytes_of(fs::path(b.out) / "manifest.json"));
-  EXPECT_EQ(bytes_of(fs::path(a.out) / "objects/phone_00/top.obj"), bytes_of(fs::path(b.out) / "objects/phone_00/top.obj"));
+  EXPECT_EQ(bytes_of(fs::path(a.out) / "objects/notebook_00/top.obj"), bytes_of(fs::path(b.out) / "objects/notebook_00/top.obj"));
 }
 
 TEST_F(Dataset, RefusesANonEmptyFolderUnlessForcedAndNeverAForeignOne) {
@@ -101,8 +101,8 @@ TEST_F(Dataset, RefusesANonEmptyFolderUnlessForcedAndNeverAForeignOne) {
   forced.force = true;
   forced.categories = {"box"};
   EXPECT_NO_THROW(synthesize_dataset(forced));
-  EXPECT_EQ(read_manifest(o.out).objects.size(), 2u);  // the old phone objects are gone
-  EXPECT_FALSE(fs::exists(fs::path(o.out) / "objects/phone_00"));
+  EXPECT_EQ(read_manifest(o.out).objects.size(), 2u);  // the old notebook objects are gone
+  EXPECT_FALSE(fs::exists(fs::path(o.out) / "objects/notebook_00"));
   // A folder with other files is never emptied.
   const fs::path foreign = root_ / "mine";
   fs::create_directories(foreign);

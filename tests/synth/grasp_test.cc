@@ -4,16 +4,12 @@
 
 #include "core/hand/lbs.h"
 #include "core/object/families/primitives.h"
-#include "core/util/data_path.h"
+#include "shipped_hands.h"
 
 namespace bimart {
 namespace {
 
-const HandModel& shipped(HandSide side) {
-  static const HandModel left = load_hand_model(find_data_file("models/hand/mano_left.npz"));
-  static const HandModel right = load_hand_model(find_data_file("models/hand/mano_right.npz"));
-  return side == HandSide::Left ? left : right;
-}
+const HandModel& shipped(HandSide side) { return *test::shipped_hands()[side == HandSide::Left ? 0 : 1]; }
 
 // A 30 x 10 x 20 cm box below y = 0 (the bottom part) and a thin lid above it.
 ArticulatedObject box_object() {
