@@ -1,4 +1,4 @@
-// bimart data synth | stats: make a synthetic data set; normalisation statistics of one.
+// bimart data synth | check | stats: make a synthetic data set, check it, normalisation statistics.
 #include <fmt/format.h>
 
 #include <iostream>
@@ -7,12 +7,13 @@
 #include "core/cli/data_stats_command.h"
 #include "core/object/families/families.h"
 #include "core/synth/dataset.h"
+#include "core/synth/dataset_check.h"
 #include "core/util/text.h"
 
 namespace bimart::cli {
 
 void add_data_commands(CLI::App& app, Commands& out) {
-  CLI::App* data = app.add_subcommand("data", "training data: synthesise a data set, its statistics");
+  CLI::App* data = app.add_subcommand("data", "training data: synthesise a data set, check it, its normalisation statistics");
   data->require_subcommand(1);
 
   static SynthOptions o;
@@ -48,6 +49,31 @@ void add_data_commands(CLI::App& app, Commands& out) {
                        s.objects, s.train, s.test, s.frames, s.seconds,
                        s.failed ? fmt::format(" ({} sequences skipped, see the warnings)", s.failed) : "");
                    for (const auto& p : s.previews) std::cout << "preview: " << p << "\n";
+                   return 0;
+                 },
+                 false});
+  static std::string check_folder, check_split = "test";
+  static int check_threads = 0;
+  static bool check_quiet = false;
+  CLI::App* check = data->add_subcommand(
+      "check", "both hands in contact while the object moves, who drives use sequences, hand-hand depth");
+  check->add_option("folder", check_folder, "data set folder (with manifest.json)")->required();
+  check->add_option("--split", check_split, "train or test")->capture_default_str();
+  check->add_option("--threads", check_threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  check->add_flag("--quiet", check_quiet, "no progress bar");
+  out.push_back({check,
+                 [] {
+                   const DatasetCheck c = check_dataset(check_folder, check_split, check_threads, !check_quiet);
+                   const auto pct = [](double a, double b) { return b > 0 ? 100.0 * a / b : 0.0; };
+                   std::cout << fmt::format(
+                       "{} {} sequences\n"
+                       "both hands touch the object: {:.2f} % of the frames where it moves ({}/{})\n"
+                       "the left hand drives:        {:.2f} % of the use sequences ({}/{})\n"
+                       "deepest hand-hand contact:   {:.2f} mm{}\n",
+                       c.sequences, check_split, pct(c.both_touching, c.moving_frames), c.both_touching,
+                       c.moving_frames, pct(c.left_drives, c.use_sequences), c.left_drives, c.use_sequences,
+                       1000 * c.hand_interpenetration,
+                       c.deepest_sequence.empty() ? "" : " (" + c.deepest_sequence + ")");
                    return 0;
                  },
                  false});

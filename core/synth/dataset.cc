@@ -110,6 +110,9 @@ SynthSummary synthesize_dataset(const SynthOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   if (o.train_objects < 1 || o.test_objects < 0 || o.sequences_per_object < 1)
     throw Error("data synth: need >= 1 train object, >= 0 test objects and >= 1 sequence per object");
+  if (!(o.trajectory.fps > 0) || o.trajectory.min_frames < 60 || o.trajectory.max_frames < o.trajectory.min_frames)
+    throw Error(fmt::format("data synth: need --fps > 0 and 60 <= --min-frames <= --max-frames (got {}, {}, {})",
+                            o.trajectory.fps, o.trajectory.min_frames, o.trajectory.max_frames));
   std::vector<std::string> categories = o.categories.empty() ? object_categories() : o.categories;
   for (const auto& c : categories) object_family(c);  // unknown names fail here, with a hint
   const HandModel left = load_hand_model(o.mano_left.empty() ? find_data_file("models/hand/mano_left.npz") : o.mano_left);
