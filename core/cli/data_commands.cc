@@ -52,7 +52,7 @@ void add_data_commands(CLI::App& app, Commands& out) {
                    return 0;
                  },
                  false});
-  static std::string check_folder, check_split = "test";
+  static std::string check_folder, check_split = "test", check_left, check_right;
   static int check_threads = 0;
   static bool check_quiet = false;
   CLI::App* check = data->add_subcommand(
@@ -60,10 +60,13 @@ void add_data_commands(CLI::App& app, Commands& out) {
   check->add_option("folder", check_folder, "data set folder (with manifest.json)")->required();
   check->add_option("--split", check_split, "train or test")->capture_default_str();
   check->add_option("--threads", check_threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  check->add_option("--mano-left", check_left, "left hand model .npz to pose the hands with (default: shipped)");
+  check->add_option("--mano-right", check_right, "right hand model .npz (give both)");
   check->add_flag("--quiet", check_quiet, "no progress bar");
   out.push_back({check,
                  [] {
-                   const DatasetCheck c = check_dataset(check_folder, check_split, check_threads, !check_quiet);
+                   const DatasetCheck c =
+                       check_dataset(check_folder, check_split, check_threads, !check_quiet, 2, check_left, check_right);
                    const auto pct = [](double a, double b) { return b > 0 ? 100.0 * a / b : 0.0; };
                    std::cout << fmt::format(
                        "{} {} sequences\n"

@@ -223,7 +223,7 @@ nlohmann::json to_json(const SetResult& s) {
 }
 
 struct EvalOptions {
-  std::string folder, ground_truth, split, json;
+  std::string folder, ground_truth, split, json, mano_left, mano_right;
   int threads = 0;
   bool quiet = false;
 };
@@ -234,6 +234,7 @@ int eval(const EvalOptions& o) {
   const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   // One sequence per thread: libtorch's own intra-op threads would only oversubscribe.
   runtime::set_threads(1);
+  if (!o.mano_left.empty() || !o.mano_right.empty()) set_posing_hand_models(o.mano_left, o.mano_right);
   const bool progress = !o.quiet;
   ObjectCache objects;
   std::vector<SetResult> sets;
@@ -264,6 +265,8 @@ void add_eval_commands(CLI::App& app, Commands& out) {
                   "only the files listed under this key of <folder>/manifest.json (e.g. test)");
   cmd->add_option("--json", o.json, "also write the results (table and per-sequence counts) to this JSON file");
   cmd->add_option("--threads", o.threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--mano-left", o.mano_left, "left hand model .npz to pose the hands with (default: the shipped hand)");
+  cmd->add_option("--mano-right", o.mano_right, "right hand model .npz (give both; e.g. converted MANO for ARCTIC data)");
   cmd->add_flag("--quiet", o.quiet, "no progress bar");
   out.push_back({cmd, [] { return eval(o); }, false});
 }

@@ -1,6 +1,7 @@
 #include "core/metrics/hand_vertices.h"
 
 #include <array>
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -15,28 +16,46 @@
 namespace bimart {
 namespace {
 
-struct ShippedHands {
+struct PosingHands {
   std::array<HandModelTensors, 2> tensors;
   std::array<std::vector<int64_t>, 2> keypoints;
 };
 
-// Loaded on first use, then shared by every thread (read-only).
-const ShippedHands& shipped_hands() {
-  static std::once_flag once;
-  static ShippedHands hands;
-  std::call_once(once, [] {
-    const char* files[2] = {"models/hand/mano_left.npz", "models/hand/mano_right.npz"};
-    for (int h = 0; h < 2; ++h) {
-      const HandModel model = load_hand_model(find_data_file(files[h]));
-      hands.tensors[h] = HandModelTensors::from(model, at::kFloat);
-      const std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
-      hands.keypoints[h].assign(ids.begin(), ids.end());
-    }
-  });
+std::shared_ptr<const PosingHands> load_posing_hands(const std::array<std::string, 2>& files) {
+  auto hands = std::make_shared<PosingHands>();
+  for (int h = 0; h < 2; ++h) {
+    const HandModel model = load_hand_model(files[h]);
+    if (model.side != (h == 0 ? HandSide::Left : HandSide::Right))
+      throw Error(files[h] + ": is a " + (h == 0 ? "right" : "left") + " hand, expected a " +
+                  (h == 0 ? "left" : "right") + " one");
+    hands->tensors[h] = HandModelTensors::from(model, at::kFloat);
+    const std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
+    hands->keypoints[h].assign(ids.begin(), ids.end());
+  }
   return hands;
 }
 
+std::mutex posing_mutex;
+std::shared_ptr<const PosingHands> posing;  // null: the shipped models, loaded on first use
+
+// The models in use, shared by every thread (read-only).
+std::shared_ptr<const PosingHands> posing_hands() {
+  std::lock_guard<std::mutex> lock(posing_mutex);
+  if (!posing)
+    posing = load_posing_hands({find_data_file("models/hand/mano_left.npz"), find_data_file("models/hand/mano_right.npz")});
+  return posing;
+}
+
 }  // namespace
+
+void set_posing_hand_models(const std::string& left_npz, const std::string& right_npz) {
+  if (left_npz.empty() != right_npz.empty())
+    throw Error("give both hand models (left and right) or neither");
+  std::shared_ptr<const PosingHands> next =
+      left_npz.empty() ? nullptr : load_posing_hands({left_npz, right_npz});  // load outside the lock
+  std::lock_guard<std::mutex> lock(posing_mutex);
+  posing = std::move(next);
+}
 
 at::Tensor hand_vertices(const HandMotion& motion) {
   const int64_t n = motion.num_frames();
@@ -47,24 +66,24 @@ at::Tensor hand_vertices(const HandMotion& motion) {
     return v.to(at::kCPU, at::kFloat).contiguous();
   }
   if (n < 1) throw Error("hand motion has no frames");
-  const ShippedHands& models = shipped_hands();
+  const std::shared_ptr<const PosingHands> models = posing_hands();
   std::vector<at::Tensor> per_hand;
   at::NoGradGuard no_grad;
   for (int h = 0; h < 2; ++h) {
     const HandParams& p = motion.hands[static_cast<size_t>(h)];
     auto f = [](const at::Tensor& t) { return t.detach().to(at::kCPU, at::kFloat).contiguous(); };
     const at::Tensor betas = f(p.shape).reshape({1, -1}).expand({n, -1}).contiguous();
-    per_hand.push_back(lbs(models.tensors[h], f(p.rot), f(p.pose), f(p.trans), betas).vertices);
+    per_hand.push_back(lbs(models->tensors[h], f(p.rot), f(p.pose), f(p.trans), betas).vertices);
   }
   return at::stack(per_hand).contiguous();
 }
 
 at::Tensor hand_keypoints(const HandMotion& motion) {
   const at::Tensor v = hand_vertices(motion);
-  const ShippedHands& models = shipped_hands();
+  const std::shared_ptr<const PosingHands> models = posing_hands();
   std::vector<at::Tensor> per_hand;
   for (int h = 0; h < 2; ++h) {
-    const auto& ids = models.keypoints[h];
+    const auto& ids = models->keypoints[h];
     for (int64_t id : ids)
       if (id >= v.size(2))
         throw Error("hand vertices have " + std::to_string(v.size(2)) +

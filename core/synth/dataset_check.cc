@@ -39,11 +39,14 @@ Points3 frame_points(const at::Tensor& v, int h, int64_t t) {  // v [2, N, V, 3]
 }  // namespace
 
 DatasetCheck check_dataset(const std::string& folder, const std::string& split, int threads, bool progress,
-                           int frame_step) {
+                           int frame_step, const std::string& mano_left, const std::string& mano_right) {
   const DatasetManifest m = read_manifest(folder);
   const std::vector<std::string> files = split_files(m, folder, split);
-  const std::array<HandModel, 2> model{load_hand_model(find_data_file("models/hand/mano_left.npz")),
-                                       load_hand_model(find_data_file("models/hand/mano_right.npz"))};
+  const bool own = !mano_left.empty() || !mano_right.empty();
+  if (own) set_posing_hand_models(mano_left, mano_right);  // hand_vertices poses with them
+  const std::array<HandModel, 2> model{
+      load_hand_model(own ? mano_left : find_data_file("models/hand/mano_left.npz")),
+      load_hand_model(own ? mano_right : find_data_file("models/hand/mano_right.npz"))};
   threads = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
   const int saved = at::get_num_threads();
   at::set_num_threads(1);

@@ -20,7 +20,9 @@ struct DatasetCheck {
 };
 
 // Every `frame_step`-th frame is used for the hand–hand depth (a tree per hand and frame).
+// Hands are posed with `mano_left`/`mano_right` when given (both), else the shipped models.
 DatasetCheck check_dataset(const std::string& folder, const std::string& split, int threads = 0,
-                           bool progress = false, int frame_step = 2);
+                           bool progress = false, int frame_step = 2, const std::string& mano_left = "",
+                           const std::string& mano_right = "");
 
 }  // namespace bimart

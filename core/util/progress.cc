@@ -2,17 +2,19 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include <iostream>
 
 namespace bimart {
 
 ProgressBar::ProgressBar(std::string label, std::size_t total, bool show)
-    : label_(std::move(label)), total_(total), show_(show) {
+    : label_(std::move(label)), total_(total), show_(show), tty_(isatty(STDERR_FILENO) != 0) {
   draw();
 }
 
 ProgressBar::~ProgressBar() {
-  if (show_) std::cerr << "\n";
+  if (show_ && tty_) std::cerr << "\n";
 }
 
 void ProgressBar::step() {
@@ -26,6 +28,13 @@ void ProgressBar::draw() {
   const std::size_t done = done_;
   constexpr int kWidth = 30;
   const int filled = total_ ? static_cast<int>(kWidth * done / total_) : kWidth;
+  if (!tty_) {  // a log file: one line per tenth, not a redrawn bar
+    const int tenth = total_ ? static_cast<int>(10 * done / total_) : 10;
+    if (tenth == last_tenth_) return;
+    last_tenth_ = tenth;
+    std::cerr << fmt::format("{}: {}/{}\n", label_, done, total_) << std::flush;
+    return;
+  }
   std::cerr << fmt::format("\r{} [{}{}] {}/{}", label_, std::string(filled, '#'), std::string(kWidth - filled, ' '),
                            done, total_)
             << std::flush;

@@ -1,4 +1,5 @@
-// A one-line progress bar on standard error for long work (DESIGN §8): "label [###   ] 3/10".
+// A one-line progress bar on standard error for long work (DESIGN §8): "label [###   ] 3/10",
+// redrawn in place on a terminal; into a file or pipe, one line "label: 3/10" per tenth.
 // step() may be called from several threads. Drawn only when `show` is set.
 #pragma once
 
@@ -23,6 +24,8 @@ class ProgressBar {
   std::string label_;
   std::size_t total_;
   bool show_;
+  bool tty_;
+  int last_tenth_ = -1;
   std::atomic<std::size_t> done_{0};
   std::mutex mutex_;
 };

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/io/sequence.h"
+#include "core/util/data_path.h"
 #include "core/object/families/families.h"
 #include "core/object/object_io.h"
 
@@ -111,6 +112,21 @@ TEST(EvalCli, TableAndJsonOnATinyFolder) {
   const CliRun gt = run_cli("--ground-truth " + (dir / "data").string() + " --split test --quiet");
   ASSERT_EQ(gt.status, 0) << gt.output;
   EXPECT_NE(gt.output.find("ground truth (1)"), std::string::npos) << gt.output;
+
+  // Own hand models: the shipped files given explicitly give the same table; a swapped
+  // pair or a single file is refused.
+  const std::string left = find_data_file("models/hand/mano_left.npz"), right = find_data_file("models/hand/mano_right.npz");
+  const CliRun own = run_cli("--ground-truth " + (dir / "data").string() + " --split test --quiet --mano-left " +
+                             left + " --mano-right " + right);
+  ASSERT_EQ(own.status, 0) << own.output;
+  EXPECT_EQ(own.output, gt.output);
+  const CliRun swapped = run_cli("--ground-truth " + (dir / "data").string() + " --split test --quiet --mano-left " +
+                                 right + " --mano-right " + left);
+  EXPECT_NE(swapped.status, 0);
+  EXPECT_NE(swapped.output.find("expected a left"), std::string::npos) << swapped.output;
+  const CliRun one = run_cli("--ground-truth " + (dir / "data").string() + " --quiet --mano-left " + left);
+  EXPECT_NE(one.status, 0);
+  EXPECT_NE(one.output.find("both hand models"), std::string::npos) << one.output;
 
   const CliRun empty = run_cli((dir / "objects").string());
   EXPECT_NE(empty.status, 0);
