@@ -2,6 +2,7 @@
 // split through the training data loader, a summary, and the normalisation file
 // (docs/data_loader.md).
 #include "core/cli/data_stats_command.h"
+#include "core/metrics/hand_vertices.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -24,6 +25,7 @@ struct StatsOptions {
   std::string variant = "np_bps";
   std::string out;
   std::string basis;
+  std::string mano_left, mano_right;
   int stride = 16;
   bool no_cache = false;
 };
@@ -44,6 +46,7 @@ int run_stats(const StatsOptions& o) {
                              done, total)
               << (done == total ? "\n" : "") << std::flush;
   };
+  if (!o.mano_left.empty() || !o.mano_right.empty()) set_posing_hand_models(o.mano_left, o.mano_right);
   const WindowDataset ds = WindowDataset::open(o.folder, "train", opt);
   const NormalizationStats stats = compute_normalization(ds);
   // Not inside FOLDER by default: `bimart eval FOLDER` reads every .npz below it as a sequence.
@@ -85,6 +88,8 @@ void add_data_stats_command(CLI::App& data, Commands& out) {
   stats->add_option("--basis", o->basis, "BPS basis file (default: the variant's shipped file under models/bps/)")
       ->check(CLI::ExistingFile);
   stats->add_option("--stride", o->stride, "frames between window starts (default 16)")->check(CLI::PositiveNumber);
+  stats->add_option("--mano-left", o->mano_left, "left hand model .npz to pose the hands with (default: shipped)");
+  stats->add_option("--mano-right", o->mano_right, "right hand model .npz (give both; e.g. converted MANO for ARCTIC)");
   stats->add_flag("--no-cache", o->no_cache, "neither read nor write the feature cache FOLDER/cache/<variant>/");
   out.push_back({stats, [o] { return run_stats(*o); }, false});
 }

@@ -4,6 +4,7 @@
 #include <ATen/Parallel.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -83,22 +84,26 @@ std::int64_t object_stamp(const std::string& path) {
   return newest;
 }
 
-// The hand keypoint ids (HandModel::keypoints of the shipped models, as the metrics use)
-// and a fingerprint of the model files, which pose the hands of files without vertices.
+// The hand keypoint ids (HandModel::keypoints of the models hand_vertices poses with, as
+// the metrics use) and a fingerprint of those files, which pose the hands of files without
+// vertices. One entry per pair of files (set_posing_hand_models may change them).
 struct HandInfo {
   std::vector<int> keypoints;
   std::string fingerprint;
 };
 
 const HandInfo& hand_info() {
-  static std::once_flag once;
-  static HandInfo info;
-  std::call_once(once, [] {
+  static std::mutex mutex;
+  static std::map<std::array<std::string, 2>, std::unique_ptr<HandInfo>> infos;
+  const std::array<std::string, 2> files = posing_hand_model_files();
+  std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<HandInfo>& slot = infos[files];
+  if (!slot) {
+    auto info = std::make_unique<HandInfo>();
     Fnv f;
     std::vector<int> ids[2];
-    const char* files[2] = {"models/hand/mano_left.npz", "models/hand/mano_right.npz"};
     for (int h = 0; h < 2; ++h) {
-      const std::string path = find_data_file(files[h]);
+      const std::string& path = files[h];
       const HandModel model = load_hand_model(path);
       ids[h] = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
       std::error_code ec;
@@ -110,10 +115,11 @@ const HandInfo& hand_info() {
       throw Error("the left and right hand models have different keypoint ids; hand features need the same J = " +
                   std::to_string(kHandKeypoints) + " ids on both sides");
     f.add(ids[0].data(), ids[0].size() * sizeof(int));
-    info.keypoints = ids[0];
-    info.fingerprint = f.hex();
-  });
-  return info;
+    info->keypoints = ids[0];
+    info->fingerprint = f.hex();
+    slot = std::move(info);
+  }
+  return *slot;
 }
 
 std::string basis_fingerprint(const BpsBasis& b) {

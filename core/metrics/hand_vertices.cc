@@ -17,12 +17,14 @@ namespace bimart {
 namespace {
 
 struct PosingHands {
+  std::array<std::string, 2> files;
   std::array<HandModelTensors, 2> tensors;
   std::array<std::vector<int64_t>, 2> keypoints;
 };
 
 std::shared_ptr<const PosingHands> load_posing_hands(const std::array<std::string, 2>& files) {
   auto hands = std::make_shared<PosingHands>();
+  hands->files = files;
   for (int h = 0; h < 2; ++h) {
     const HandModel model = load_hand_model(files[h]);
     if (model.side != (h == 0 ? HandSide::Left : HandSide::Right))
@@ -56,6 +58,8 @@ void set_posing_hand_models(const std::string& left_npz, const std::string& righ
   std::lock_guard<std::mutex> lock(posing_mutex);
   posing = std::move(next);
 }
+
+std::array<std::string, 2> posing_hand_model_files() { return posing_hands()->files; }
 
 at::Tensor hand_vertices(const HandMotion& motion) {
   const int64_t n = motion.num_frames();

@@ -2,6 +2,7 @@
 // the world frame, and the J surface keypoints for the contact-map measure.
 #pragma once
 
+#include <array>
 #include <string>
 
 #include <ATen/core/Tensor.h>
@@ -20,6 +21,8 @@ at::Tensor hand_vertices(const HandMotion& motion);
 // data needs); both empty: back to the shipped models. Throws bimart::Error for a file that
 // does not load or a swapped side. Thread-safe.
 void set_posing_hand_models(const std::string& left_npz, const std::string& right_npz);
+// The files hand_vertices poses with now: {left, right}.
+std::array<std::string, 2> posing_hand_model_files();
 
 // [2, N, J, 3] float32: the J = 100 surface keypoints (the model's keypoint vertex ids)
 // taken from hand_vertices(motion).

@@ -4,6 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <ATen/ATen.h>
+
+#include "core/metrics/hand_vertices.h"
+#include "core/util/data_path.h"
+
 #include <filesystem>
 
 #include "core/data/normalization.h"
@@ -58,6 +63,18 @@ TEST(DataStatsCli, WritesTheNormalisationFile) {
   ASSERT_EQ(status, 0);
   EXPECT_NE(text.find("windows    5 of 64 frames, stride 32"), std::string::npos) << text;  // 0, 32, 36; 0; 0
   EXPECT_EQ(load_normalization((dir / "cwd" / "stats_u_bps.npz").string()).variant, "u_bps");
+
+  // Own hand models (here the shipped files, named explicitly) pose the hands: same numbers.
+  const fs::path own = dir / "cli" / "stats_own.npz";
+  ASSERT_EQ(run_data("stats " + dir.string() + " --out " + own.string() + " --no-cache --mano-left " +
+                         find_data_file("models/hand/mano_left.npz") + " --mano-right " +
+                         find_data_file("models/hand/mano_right.npz"),
+                     &text),
+            0);
+  set_posing_hand_models("", "");  // back to the default for the other tests
+  const NormalizationStats a = load_normalization(out.string()), b = load_normalization(own.string());
+  EXPECT_TRUE(at::equal(a.x_mean, b.x_mean));
+  EXPECT_TRUE(at::equal(a.c_std, b.c_std));
 
   EXPECT_THROW(run_data("stats " + dir.string() + " --variant npbps", &text), CLI::ValidationError);
   EXPECT_THROW(run_data("stats " + (dir / "nowhere").string(), &text), CLI::ValidationError);
