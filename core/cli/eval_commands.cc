@@ -24,6 +24,7 @@
 #include "core/metrics/hand_vertices.h"
 #include "core/metrics/multimodality.h"
 #include "core/metrics/sequence_metrics.h"
+#include "core/object/object_cache.h"
 #include "core/object/object_io.h"
 #include "core/runtime/blas.h"
 #include "core/util/atomic_file.h"
@@ -67,35 +68,6 @@ std::vector<std::string> sequence_files(const std::string& folder, const std::st
   if (files.empty()) throw Error(folder + ": no .npz sequence files" + (split.empty() ? "" : " in split " + split));
   return files;
 }
-
-// Objects by resolved path, each loaded and its distance trees built once, shared by threads.
-class ObjectCache {
- public:
-  struct Entry {
-    ArticulatedObject object;
-    std::unique_ptr<ObjectDistance> distance;
-  };
-  std::shared_ptr<const Entry> get(const std::string& path) {
-    std::shared_ptr<std::once_flag> once;
-    std::shared_ptr<Entry> entry;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      auto& slot = entries_[path];
-      if (!slot.second) slot = {std::make_shared<std::once_flag>(), std::make_shared<Entry>()};
-      once = slot.first;
-      entry = slot.second;
-    }
-    std::call_once(*once, [&] {
-      entry->object = load_object(path);
-      entry->distance = std::make_unique<ObjectDistance>(entry->object);
-    });
-    return entry;
-  }
-
- private:
-  std::mutex mutex_;
-  std::map<std::string, std::pair<std::shared_ptr<std::once_flag>, std::shared_ptr<Entry>>> entries_;
-};
 
 struct SetResult {
   std::string label, folder;

@@ -11,6 +11,7 @@
 #include "core/hand/keypoints.h"
 #include "core/hand/procedural_hand_mesh.h"
 #include "core/util/error.h"
+#include "core/util/random.h"
 
 namespace bimart {
 
@@ -394,21 +395,11 @@ Eigen::VectorXd mirror_pose(Eigen::VectorXd pose) {
   return pose;
 }
 
-// Portable random numbers: mt19937_64 is fully specified; the distributions are ours.
-struct Rng {
-  std::mt19937_64 engine;
-  double uniform() { return static_cast<double>(engine() >> 11) * 0x1.0p-53; }
-  double normal() {
-    const double u1 = 1.0 - uniform(), u2 = uniform();
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * M_PI * u2);
-  }
-};
-
 // PCA of sampled plausible finger poses: an overall curl (open hand to loose fist), each
 // digit deviating from it, a little spread, and joint noise. Rows of the basis are unit
 // principal directions, largest variance first, each with its largest entry positive.
 void pose_pca(int samples, std::uint64_t seed, Eigen::MatrixXd* components, Eigen::VectorXd* mean) {
-  Rng rng{std::mt19937_64(seed)};
+  Rng rng(seed);  // portable (core/util/random.h)
   constexpr std::array<double, 5> kSpreadSign{1.0, 0.2, -1.4, -0.8, 0.6};
   Eigen::MatrixXd X(samples, 45);
   for (int i = 0; i < samples; ++i) {

@@ -1,9 +1,7 @@
 #include "core/synth/dataset_check.h"
 
 #include <algorithm>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <thread>
 
 #include <ATen/ATen.h>
@@ -17,19 +15,13 @@
 #include "core/metrics/contact.h"
 #include "core/metrics/frame_depths.h"
 #include "core/metrics/hand_vertices.h"
-#include "core/object/object_distance.h"
-#include "core/object/object_io.h"
+#include "core/object/object_cache.h"
 #include "core/util/data_path.h"
 #include "core/util/parallel.h"
 #include "core/util/progress.h"
 
 namespace bimart {
 namespace {
-
-struct Loaded {
-  ArticulatedObject object;
-  std::unique_ptr<ObjectDistance> distance;
-};
 
 Points3 frame_points(const at::Tensor& v, int h, int64_t t) {  // v [2, N, V, 3] double
   const at::Tensor f = v[h][t].contiguous();
@@ -51,25 +43,14 @@ DatasetCheck check_dataset(const std::string& folder, const std::string& split, 
   const int saved = at::get_num_threads();
   at::set_num_threads(1);
 
-  std::mutex mutex;
-  std::map<std::string, std::shared_ptr<Loaded>> objects;
+  ObjectCache objects;
   std::vector<DatasetCheck> parts(files.size());
   {
     ProgressBar bar("checking " + split, files.size(), progress);
     parallel_for(files.size(), threads, [&](size_t i) {
       const Sequence s = read_sequence(files[i]);
       const std::string path = resolve_object_path(s, files[i]);
-      std::shared_ptr<Loaded> obj;
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        auto& slot = objects[path];
-        if (!slot) {
-          slot = std::make_shared<Loaded>();
-          slot->object = load_object(path);
-          slot->distance = std::make_unique<ObjectDistance>(slot->object);
-        }
-        obj = slot;
-      }
+      const auto obj = objects.get(path);
       DatasetCheck& c = parts[i];
       c.sequences = 1;
       const at::Tensor v = hand_vertices(s.hands).to(at::kDouble).contiguous();

@@ -23,12 +23,6 @@ constexpr int kThumb = 4;
 // procedural hand's pose samples.
 constexpr std::array<double, 5> kFan{1.0, 0.2, -1.4, -0.8, 0.6};
 
-Points3 transformed(const Eigen::Isometry3d& T, const Points3& p) {
-  Points3 out(p.rows(), 3);
-  for (Eigen::Index i = 0; i < p.rows(); ++i) out.row(i) = (T * p.row(i).transpose()).transpose();
-  return out;
-}
-
 Points3 rows(const Points3& p, const std::vector<int>& ids) {
   Points3 out(static_cast<Eigen::Index>(ids.size()), 3);
   for (size_t i = 0; i < ids.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = p.row(ids[i]);
@@ -91,10 +85,18 @@ GraspPlanner::GraspPlanner(const ArticulatedObject& object, const ObjectDistance
   bottom_ = {ObjectPart::Bottom, &object.bottom, vertex_normals(object.bottom)};
 }
 
+const MeshDistance& GraspPlanner::other_part(ObjectPart part) const {
+  return part == ObjectPart::Top ? distance_.bottom() : distance_.top();
+}
+
+Points3 GraspPlanner::in_other_frame(ObjectPart part, double angle, const Points3& points) const {
+  // The top part's frame -> canonical (= the bottom's frame), or back.
+  const Eigen::Isometry3d T = part == ObjectPart::Top ? top_to_canonical(angle) : top_to_canonical(angle).inverse();
+  return transform_vertices(T, points);
+}
+
 double GraspPlanner::depth_other(ObjectPart part, double angle, const Points3& points) const {
-  if (part == ObjectPart::Top)  // top frame -> canonical = the bottom's frame
-    return distance_.bottom().max_signed_distance(transformed(top_to_canonical(angle), points));
-  return distance_.top().max_signed_distance(transformed(top_to_canonical(angle).inverse(), points));
+  return other_part(part).max_signed_distance(in_other_frame(part, angle, points));
 }
 
 double GraspPlanner::depth(ObjectPart part, double angle, const Points3& points) const {
@@ -104,10 +106,8 @@ double GraspPlanner::depth(ObjectPart part, double angle, const Points3& points)
 
 bool GraspPlanner::deeper_than(ObjectPart part, double angle, const Points3& points, double threshold) const {
   const MeshDistance& own = part == ObjectPart::Top ? distance_.top() : distance_.bottom();
-  if (own.any_deeper_than(points, threshold)) return true;
-  if (part == ObjectPart::Top)
-    return distance_.bottom().any_deeper_than(transformed(top_to_canonical(angle), points), threshold);
-  return distance_.top().any_deeper_than(transformed(top_to_canonical(angle).inverse(), points), threshold);
+  return own.any_deeper_than(points, threshold) ||
+         other_part(part).any_deeper_than(in_other_frame(part, angle, points), threshold);
 }
 
 std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const GraspRequest& req, int vertex,
@@ -167,15 +167,15 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   const MeshDistance& own = req.part == ObjectPart::Top ? distance_.top() : distance_.bottom();
   // Start from a clear pose: 6 cm off the surface, or closer where the table or the other
   // part leaves less room (under an object on a stand).
-  while (blocked(transformed(place(hi), coarse), kTouch))
+  while (blocked(transform_vertices(place(hi), coarse), kTouch))
     if ((hi *= 0.5) < 0.007) return reject(Reject::Obstructed);
-  if (!own.any_deeper_than(transformed(place(lo), coarse), kTouch)) return reject(Reject::Obstructed);
+  if (!own.any_deeper_than(transform_vertices(place(lo), coarse), kTouch)) return reject(Reject::Obstructed);
   for (int it = 0; it < 10; ++it) {  // 9 cm / 2^10: 0.1 mm
     const double mid = 0.5 * (lo + hi);
-    (blocked(transformed(place(mid), coarse), kTouch) ? lo : hi) = mid;
+    (blocked(transform_vertices(place(mid), coarse), kTouch) ? lo : hi) = mid;
   }
   T = place(hi);
-  if (own.max_signed_distance(transformed(T, coarse)) < -kContact) return reject(Reject::HeldOff);
+  if (own.max_signed_distance(transform_vertices(T, coarse)) < -kContact) return reject(Reject::HeldOff);
 
   // Close the digits together until each one touches (or reaches its rest curl in the air).
   const std::array<double, 5> limit{1.0, 1.0, 1.0, 1.0, 1.0};
@@ -186,7 +186,7 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   std::array<double, 5> ok = g.curl, bad{};
   std::array<bool, 5> done{}, hit{};
   auto digits_blocked = [&](const std::array<double, 5>& curl, const std::array<bool, 5>& ask) {
-    const Points3 v = transformed(T, local_hand_vertices(hand, grasp_finger_pose(hand, curl, g.spread)));
+    const Points3 v = transform_vertices(T, local_hand_vertices(hand, grasp_finger_pose(hand, curl, g.spread)));
     std::array<bool, 5> b{};
     for (int c = 0; c < 5; ++c) b[c] = ask[c] && blocked(rows(v, hand.digits[c]), kTouch);
     return b;
@@ -232,16 +232,14 @@ std::optional<Grasp> GraspPlanner::try_site(const HandGeometry& hand, const Gras
   g.curl = ok;
   g.finger_pose = grasp_finger_pose(hand, g.curl, g.spread);
   g.part_from_hand = T;
-  const Points3 v = transformed(T, local_hand_vertices(hand, g.finger_pose));
+  const Points3 v = transform_vertices(T, local_hand_vertices(hand, g.finger_pose));
   const Eigen::VectorXd sd = own.signed_distances(v);
   g.depth = std::max(sd.maxCoeff(), depth_other(req.part, req.angle, v));
   g.contacts = static_cast<int>((sd.array() > -kContact).count());
   if (g.depth > req.max_depth || blocked(v, req.max_depth) || g.contacts < 5) return reject(Reject::Final);
-  for (double a : req.hold_angles) {  // the other part must not move into the hand
-    const Eigen::Isometry3d rel = req.part == ObjectPart::Top ? top_to_canonical(a) : top_to_canonical(a).inverse();
-    const MeshDistance& other = req.part == ObjectPart::Top ? distance_.bottom() : distance_.top();
-    if (other.any_deeper_than(transformed(rel, v), req.max_depth)) return reject(Reject::Hinge);
-  }
+  for (double a : req.hold_angles)  // the other part must not move into the hand
+    if (other_part(req.part).any_deeper_than(in_other_frame(req.part, a, v), req.max_depth))
+      return reject(Reject::Hinge);
   if (req.accept_hand && !req.accept_hand(v)) return reject(Reject::OtherHand);
   return g;
 }

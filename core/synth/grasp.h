@@ -111,6 +111,9 @@ class GraspPlanner {
   using RejectCounts = std::array<int, static_cast<size_t>(Reject::Count)>;
   std::optional<Grasp> try_site(const HandGeometry& hand, const GraspRequest& request, int vertex,
                                 double wrist_angle, Rng& rng, RejectCounts& counts) const;
+  const MeshDistance& other_part(ObjectPart part) const;
+  // `points` given in the frame of `part`, moved into the other part's frame at `angle`.
+  Points3 in_other_frame(ObjectPart part, double angle, const Points3& points) const;
   const ArticulatedObject& object_;
   const ObjectDistance& distance_;
   PartSurface top_, bottom_;

@@ -10,6 +10,7 @@
 #include "core/geometry/rotation.h"
 #include "core/synth/grasp.h"
 #include "core/synth/motion_table.h"
+#include "core/object/object_state.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/random.h"
@@ -35,12 +36,6 @@ Eigen::Isometry3d interpolate(const Eigen::Isometry3d& a, const Eigen::Isometry3
   const Eigen::Vector3d pa = a * pivot, pb = b * pivot;
   T.translation() = pa + s * (pb - pa) - T.linear() * pivot;
   return T;
-}
-
-Points3 transformed(const Eigen::Isometry3d& T, const Points3& p) {
-  Points3 out(p.rows(), 3);
-  for (Eigen::Index i = 0; i < p.rows(); ++i) out.row(i) = (T * p.row(i).transpose()).transpose();
-  return out;
 }
 
 Eigen::Vector3d random_axis(Rng& rng) {
@@ -95,7 +90,7 @@ Motion build_motion(const Trajectory& tr, const std::array<HandPlan, 2>& plans,
         T = p.post, fingers = p.open_after;
       }
       m.pose[h].push_back(T);
-      m.vertices[h].push_back(transformed(T, holding ? held : local_hand_vertices(geo[h], fingers)));
+      m.vertices[h].push_back(transform_vertices(T, holding ? held : local_hand_vertices(geo[h], fingers)));
       m.fingers[h].push_back(std::move(fingers));
     }
   }
@@ -241,7 +236,7 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
       };
       if (second) {  // clear of the first hand at every angle passed while both hold
         const HandPlan& q = plans[first_hand];
-        const Points3 first_v = transformed(q.grasp.part_from_hand, local_hand_vertices(geo[first_hand], q.grasp.finger_pose));
+        const Points3 first_v = transform_vertices(q.grasp.part_from_hand, local_hand_vertices(geo[first_hand], q.grasp.finger_pose));
         std::vector<double> angles = req.hold_angles;
         angles.push_back(s.angle);
         req.accept_hand = [&, first_v, angles, q](const Points3& v) {
@@ -250,7 +245,7 @@ HandMotion synthesize_hands(const ArticulatedObject& object, const ObjectDistanc
               return p == ObjectPart::Top ? top_to_canonical(a) : Eigen::Isometry3d::Identity();
             };
             const Eigen::Isometry3d rel = canonical_from(req.part).inverse() * canonical_from(q.grasp.part);
-            const NearestPoints tree(transformed(rel, first_v));
+            const NearestPoints tree(transform_vertices(rel, first_v));
             std::vector<int> idx(static_cast<size_t>(v.rows()));
             std::vector<double> d2(static_cast<size_t>(v.rows()));
             tree.nearest(v, idx.data(), d2.data());

@@ -13,26 +13,14 @@
 #include "core/hand/lbs_torch.h"
 #include "core/object/families/primitives.h"
 #include "core/util/data_path.h"
+#include "bench_object.h"
 
 namespace bimart {
 namespace {
 
 constexpr int kFrames = 64;
 
-// Two rounded boxes, spacing chosen so that the object has about 4,000 vertices.
-const ArticulatedObject& object() {
-  static const ArticulatedObject o = [] {
-    ArticulatedObject a;
-    a.name = "bench";
-    for (double spacing = 0.02;; spacing *= 0.97) {
-      a.bottom = shapes::rounded_box({-0.15, -0.25, -0.04}, {0.15, 0.0, 0.0}, 0.005, spacing);
-      a.top = shapes::rounded_box({-0.15, 0.0, -0.01}, {0.15, 0.22, 0.0}, 0.003, spacing);
-      if (a.top.num_vertices() + a.bottom.num_vertices() >= 4000) break;
-    }
-    return a;
-  }();
-  return o;
-}
+const ArticulatedObject& object() { return bench::bench_object(); }
 
 at::Tensor states() {
   at::Tensor s = at::zeros({kFrames, 7});

@@ -12,6 +12,7 @@
 #include "core/metrics/sequence_metrics.h"
 #include "core/object/families/primitives.h"
 #include "core/object/object_state.h"
+#include "bench_object.h"
 
 namespace bimart {
 namespace {
@@ -19,19 +20,7 @@ namespace {
 constexpr int kFrames = 64;
 constexpr int kHandVertices = 778;
 
-const ArticulatedObject& bench_object() {
-  static const ArticulatedObject o = [] {
-    ArticulatedObject a;
-    a.name = "bench";
-    for (double spacing = 0.02;; spacing *= 0.97) {
-      a.bottom = shapes::rounded_box({-0.15, -0.25, -0.04}, {0.15, 0.0, 0.0}, 0.005, spacing);
-      a.top = shapes::rounded_box({-0.15, 0.0, -0.01}, {0.15, 0.22, 0.0}, 0.003, spacing);
-      if (a.top.num_vertices() + a.bottom.num_vertices() >= 4000) break;
-    }
-    return a;
-  }();
-  return o;
-}
+using bench::bench_object;
 
 // The object turns, moves and opens; each hand's vertices are object surface points (left:
 // bottom part, right: top part) jittered by 1 cm, so about half are inside. With `outside`

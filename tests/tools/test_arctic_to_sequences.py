@@ -20,6 +20,8 @@ import tempfile
 
 import numpy as np
 
+from tool_checks import check, run  # tests/tools/tool_checks.py
+
 N = 24  # frames per fake sequence
 
 
@@ -81,19 +83,6 @@ def build_tree(root, rng, objects=("box",)):
     # Other ARCTIC files beside them are ignored.
     np.save(os.path.join(root, "raw_seqs", "s01", "box_grab_01.egocam.dist.npy"), np.zeros((N, 3)))
     return seqs
-
-
-def run(cmd, expect_rc=0):
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != expect_rc:
-        sys.exit(f"FAIL: {' '.join(cmd)} returned {r.returncode}, expected {expect_rc}\n{r.stdout}\n{r.stderr}")
-    return r
-
-
-def check(cond, what):
-    if not cond:
-        sys.exit(f"FAIL: {what}")
-    print(f"ok: {what}")
 
 
 def main():

@@ -19,6 +19,8 @@ import textwrap
 
 import numpy as np
 
+from tool_checks import check, run  # tests/tools/tool_checks.py
+
 V, F = 20, 30
 PARENTS = [-1, 0, 1, 2, 0, 4, 5, 0, 7, 8, 0, 10, 11, 0, 13, 14]
 TIPS = [1, 5, 9, 13, 17]
@@ -109,19 +111,6 @@ def write_fake_pickle(tmp, arrays, path):
     subprocess.run([sys.executable, "-c", WRITER, src, path], env=env, check=True)
 
 
-def run(cmd, expect_ok=True, env=None):
-    r = subprocess.run(cmd, capture_output=True, text=True, env=env)
-    if (r.returncode == 0) != expect_ok:
-        sys.exit(f"FAIL: {' '.join(cmd)} returned {r.returncode}\n{r.stdout}\n{r.stderr}")
-    return r
-
-
-def check(cond, what):
-    if not cond:
-        sys.exit(f"FAIL: {what}")
-    print(f"ok: {what}")
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--converter", required=True)
@@ -143,7 +132,7 @@ def main():
               "the fake pickle is protocol 2 and names chumpy.ch.Ch and scipy.sparse.csc.csc_matrix")
 
         right = os.path.join(tmp, "right.npz")
-        r = run(conv + [right_pkl, right], expect_ok=False)
+        r = run(conv + [right_pkl, right], expect_rc=None)
         check("fingertip vertex ids" in r.stderr and "below 20" in r.stderr,
               "MANO's fingertip ids are refused on a 20-vertex mesh, with a clear message")
         run(conv + [right_pkl, right] + tips)
@@ -170,14 +159,14 @@ def main():
         check(np.array_equal(b["shapedirs"][:, 0, :], -src["shapedirs"][:, 0, :]) and
               np.array_equal(b["shapedirs"][:, 1:, :], src["shapedirs"][:, 1:, :]),
               "--fix-left-shapedirs negates shapedirs[:, 0, :] only")
-        r = run(conv + [right_pkl, os.path.join(tmp, "x.npz"), "--fix-left-shapedirs"] + tips, expect_ok=False)
+        r = run(conv + [right_pkl, os.path.join(tmp, "x.npz"), "--fix-left-shapedirs"] + tips, expect_rc=None)
         check("left hand only" in r.stderr, "--fix-left-shapedirs refused for the right hand")
-        r = run(conv + [os.path.join(tmp, "hand.pkl"), os.path.join(tmp, "x.npz")], expect_ok=False)
+        r = run(conv + [os.path.join(tmp, "hand.pkl"), os.path.join(tmp, "x.npz")], expect_rc=None)
         check("give --side" in r.stderr, "a file name without LEFT/RIGHT needs --side")
         with open(os.path.join(tmp, "MANO_RIGHT_broken.pkl"), "wb") as f:
             f.write(b"not a pickle")
         r = run(conv + [os.path.join(tmp, "MANO_RIGHT_broken.pkl"), os.path.join(tmp, "x.npz")],
-                expect_ok=False)
+                expect_rc=None)
         check("not a readable MANO pickle" in r.stderr, "a broken pickle is reported")
         check(not os.path.exists(os.path.join(tmp, "x.npz")), "no output after a failure")
 
