@@ -4,6 +4,7 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/compute_normal.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Side_of_triangle_mesh.h>
@@ -197,8 +198,21 @@ SurfaceQuery MeshDistance::query(const Eigen::Vector3d& p) const {
       out.face = impl_->face_index[static_cast<size_t>(h.second.idx())];
     }
   }
+  const Eigen::Vector3d d = p - out.closest;
+  const double dn = d.norm();
+  if (dn > 1e-9) {
+    out.normal = (depth < 0 ? 1.0 : -1.0) * d / dn;
+  } else {  // on the surface: the nearest face's normal, pointing out of the mesh
+    const auto n = CGAL::Polygon_mesh_processing::compute_face_normal(hit.second, impl_->mesh);
+    out.normal = Eigen::Vector3d(n.x(), n.y(), n.z()).normalized();
+    const Eigen::Vector3d probe = out.closest + 1e-6 * out.normal;
+    if (depth_inside(impl_->components, Point(probe.x(), probe.y(), probe.z()), nullptr) > 0)
+      out.normal = -out.normal;
+  }
   return out;
 }
+
+Eigen::AlignedBox3d MeshDistance::bounding_box() const { return Eigen::AlignedBox3d(impl_->lo, impl_->hi); }
 
 double MeshDistance::signed_distance(const Eigen::Vector3d& p) const {
   const Point q(p.x(), p.y(), p.z());

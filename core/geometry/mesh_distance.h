@@ -7,6 +7,7 @@
 #include <memory>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "core/geometry/triangle_mesh.h"
 
@@ -16,6 +17,9 @@ struct SurfaceQuery {
   double signed_distance = 0;  // metres; > 0 inside
   Eigen::Vector3d closest = Eigen::Vector3d::Zero();  // nearest surface point, mesh frame
   int face = -1;                                      // face of the nearest point
+  // Unit outward normal there: along p − closest (towards p outside, away inside); from
+  // the nearest face, oriented by an inside probe, for a point on the surface.
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 };
 
 class MeshDistance {
@@ -34,6 +38,8 @@ class MeshDistance {
   // Closed components (by shared vertices). A part may be a union of overlapping closed
   // components; "inside" means inside any of them (ray parity runs per component).
   int num_components() const;
+  // The axis-aligned bounding box of the mesh's vertices.
+  Eigen::AlignedBox3d bounding_box() const;
   // max over the rows of signed_distances(points), without computing every distance: rows
   // that cannot beat the best so far (bounded by the mesh's bounding box) are skipped.
   // -infinity for no rows.

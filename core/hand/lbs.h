@@ -64,6 +64,35 @@ void axis_angle_to_matrix(const T* aa, T* R) {
   R[8] = T(1) + b * (z * z - theta2);
 }
 
+// The kinematic chain: local rotations R_j (row-major 3x3) and rest joints J_j give the
+// global transforms G_j = [GR_j | Gt_j] and the skinning offsets At_j = Gt_j − GR_j·J_j.
+// Shared by lbs() and lbs_subset() (core/hand/lbs_subset.h). TJ is T or double.
+template <class T, class TJ>
+void kinematic_chain(const std::array<int, HandModel::kNumJoints>& parents,
+                     const T (&R)[HandModel::kNumJoints][9], const TJ (&J)[HandModel::kNumJoints][3],
+                     T (&GR)[HandModel::kNumJoints][9], T (&Gt)[HandModel::kNumJoints][3],
+                     T (&At)[HandModel::kNumJoints][3]) {
+  for (int j = 0; j < HandModel::kNumJoints; ++j) {
+    const int p = parents[j];
+    if (p < 0) {
+      for (int e = 0; e < 9; ++e) GR[j][e] = R[j][e];
+      for (int k = 0; k < 3; ++k) Gt[j][k] = T(J[j][k]);
+    } else {
+      const TJ rel[3] = {J[j][0] - J[p][0], J[j][1] - J[p][1], J[j][2] - J[p][2]};
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c)
+          GR[j][3 * r + c] = GR[p][3 * r] * R[j][c] + GR[p][3 * r + 1] * R[j][3 + c] +
+                             GR[p][3 * r + 2] * R[j][6 + c];
+        Gt[j][r] = GR[p][3 * r] * rel[0] + GR[p][3 * r + 1] * rel[1] + GR[p][3 * r + 2] * rel[2] +
+                   Gt[p][r];
+      }
+    }
+    for (int r = 0; r < 3; ++r)
+      At[j][r] = Gt[j][r] - (GR[j][3 * r] * J[j][0] + GR[j][3 * r + 1] * J[j][1] +
+                             GR[j][3 * r + 2] * J[j][2]);
+  }
+}
+
 // Posed hand. rot (3): global axis-angle; pose (45): finger axis-angle, flat; trans (3);
 // betas (10). Model matrices stay double; only the products with T are formed. The model
 // must be valid (load_hand_model validates; call validate() on one built in code).
@@ -113,25 +142,7 @@ void lbs(const HandModel& m, const T* rot, const T* pose, const T* trans, const 
 
   // Global transforms G_j = [GR | Gt], then A_j = G_j · [I | −J_j] for skinning.
   T GR[kJ][9], Gt[kJ][3], At[kJ][3];
-  for (int j = 0; j < kJ; ++j) {
-    const int p = m.parents[j];
-    if (p < 0) {
-      for (int e = 0; e < 9; ++e) GR[j][e] = R[j][e];
-      for (int k = 0; k < 3; ++k) Gt[j][k] = J[j][k];
-    } else {
-      T rel[3] = {J[j][0] - J[p][0], J[j][1] - J[p][1], J[j][2] - J[p][2]};
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c)
-          GR[j][3 * r + c] = GR[p][3 * r] * R[j][c] + GR[p][3 * r + 1] * R[j][3 + c] +
-                             GR[p][3 * r + 2] * R[j][6 + c];
-        Gt[j][r] = GR[p][3 * r] * rel[0] + GR[p][3 * r + 1] * rel[1] + GR[p][3 * r + 2] * rel[2] +
-                   Gt[p][r];
-      }
-    }
-    for (int r = 0; r < 3; ++r)
-      At[j][r] = Gt[j][r] - (GR[j][3 * r] * J[j][0] + GR[j][3 * r + 1] * J[j][1] +
-                             GR[j][3 * r + 2] * J[j][2]);
-  }
+  kinematic_chain(m.parents, R, J, GR, Gt, At);
 
   // Skinning: blend the 3x4 transforms by weight (skipping zero weights), apply, translate.
   out->vertices.resize(V, 3);

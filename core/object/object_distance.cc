@@ -31,13 +31,14 @@ ObjectSurfaceQuery ObjectDistance::query(const ObjectState& state, const Eigen::
   ObjectSurfaceQuery out;
   auto from_top = [&]() {
     const SurfaceQuery q = top_.query(f.world_to_top * p_world);
-    return ObjectSurfaceQuery{q.signed_distance,
-                              canonical_to_w * (top_to_canonical(state.angle) * q.closest),
-                              ObjectPart::Top};
+    const Eigen::Isometry3d top_to_w = canonical_to_w * top_to_canonical(state.angle);
+    return ObjectSurfaceQuery{q.signed_distance, top_to_w * q.closest, ObjectPart::Top,
+                              top_to_w.linear() * q.normal};
   };
   auto from_bottom = [&]() {
     const SurfaceQuery q = bottom_.query(f.world_to_bottom * p_world);
-    return ObjectSurfaceQuery{q.signed_distance, canonical_to_w * q.closest, ObjectPart::Bottom};
+    return ObjectSurfaceQuery{q.signed_distance, canonical_to_w * q.closest, ObjectPart::Bottom,
+                              canonical_to_w.linear() * q.normal};
   };
   if (part == ObjectPart::Top) return from_top();
   if (part == ObjectPart::Bottom) return from_bottom();
@@ -62,6 +63,24 @@ Eigen::VectorXd ObjectDistance::signed_distances(const ObjectState& state,
       out(i) = std::max(top_.signed_distance(f.world_to_top * p),
                         bottom_.signed_distance(f.world_to_bottom * p));
     }
+  }
+  return out;
+}
+
+std::vector<std::pair<int, ObjectSurfaceQuery>> ObjectDistance::near_surface(
+    const ObjectState& state, const Points3& points_world, double margin) const {
+  const PartFrames f = part_frames(state);
+  const Eigen::AlignedBox3d top_box = top_.bounding_box(), bottom_box = bottom_.bounding_box();
+  std::vector<std::pair<int, ObjectSurfaceQuery>> out;
+  for (Eigen::Index i = 0; i < points_world.rows(); ++i) {
+    const Eigen::Vector3d p = points_world.row(i).transpose();
+    const bool near_top = top_box.exteriorDistance(f.world_to_top * p) <= margin;
+    const bool near_bottom = bottom_box.exteriorDistance(f.world_to_bottom * p) <= margin;
+    if (!near_top && !near_bottom) continue;
+    const ObjectPart part = near_top && near_bottom ? ObjectPart::Whole
+                                                    : (near_top ? ObjectPart::Top : ObjectPart::Bottom);
+    const ObjectSurfaceQuery q = query(state, p, part);
+    if (q.signed_distance > -margin) out.emplace_back(static_cast<int>(i), q);
   }
   return out;
 }

@@ -4,6 +4,9 @@
 // The whole object is the union of both parts: sd = max(sd_top, sd_bottom).
 #pragma once
 
+#include <utility>
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "core/geometry/mesh_distance.h"
@@ -18,6 +21,7 @@ struct ObjectSurfaceQuery {
   double signed_distance = 0;                         // metres; > 0 inside
   Eigen::Vector3d closest = Eigen::Vector3d::Zero();  // nearest surface point, world frame
   ObjectPart part = ObjectPart::Bottom;               // the part the nearest point lies on
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();   // unit outward normal there, world frame
 };
 
 class ObjectDistance {
@@ -35,6 +39,13 @@ class ObjectDistance {
   // (MeshDistance::max_signed_distance): the deepest point, as Pen, Con and Art need.
   double max_signed_distance(const ObjectState& state, const Points3& points_world,
                              ObjectPart part = ObjectPart::Whole) const;
+
+  // The points (rows) inside the object or within `margin` (m) of its surface, with their
+  // queries (the part with the larger signed distance); the rest are skipped after a
+  // bounding-box test per part, which makes this cheap for a hand beside an object.
+  std::vector<std::pair<int, ObjectSurfaceQuery>> near_surface(const ObjectState& state,
+                                                               const Points3& points_world,
+                                                               double margin) const;
 
   const MeshDistance& top() const { return top_; }
   const MeshDistance& bottom() const { return bottom_; }

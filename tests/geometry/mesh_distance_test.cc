@@ -54,6 +54,22 @@ TEST(MeshDistance, UnitCubeKnownDepths) {
   EXPECT_EQ(d.num_components(), 1);
 }
 
+TEST(MeshDistance, NormalsPointOutOfTheMeshInsideOutsideAndOnTheSurface) {
+  TriangleMesh box = make_box({0, 0, 0}, {1, 1, 1});
+  TriangleMesh flipped = box;  // inward winding: the probe must still orient it outwards
+  flipped.faces.col(1).swap(flipped.faces.col(2));
+  for (const TriangleMesh* m : {&box, &flipped}) {
+    const MeshDistance d(*m);
+    for (const Eigen::Vector3d p : {Eigen::Vector3d(0.5, 0.4, 1.2), Eigen::Vector3d(0.5, 0.4, 0.9),
+                                    Eigen::Vector3d(0.5, 0.4, 1.0)}) {
+      const SurfaceQuery q = d.query(p);
+      EXPECT_NEAR(q.normal.z(), 1.0, 1e-12) << p.transpose();
+      EXPECT_NEAR(q.normal.head<2>().norm(), 0.0, 1e-12);
+    }
+    EXPECT_NEAR(d.query({-0.3, 0.5, 0.5}).normal.x(), -1.0, 1e-12);
+  }
+}
+
 TEST(MeshDistance, CylinderKnownDepths) {
   const int n = 64;
   const double r = 0.05, h = 0.1;

@@ -1,0 +1,490 @@
+#include "core/refine/refinement.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+#include <vector>
+
+#include <ATen/ATen.h>
+#include <fmt/format.h>
+
+#include "core/features/hand_features.h"
+#include "core/hand/keypoints.h"
+#include "core/hand/lbs_subset.h"
+#include "core/refine/hand_state.h"
+#include "core/refine/mano_fit.h"
+#include "core/util/error.h"
+#include "core/util/parallel.h"
+
+namespace bimart {
+namespace {
+
+constexpr int kJ = 100;
+constexpr int kX = kHandStateSize;
+using Jet = ceres::Jet<double, kX>;
+
+struct Plane {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // on the surface
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward
+};
+
+// One frame's linearisation: the vertices posed (keypoints first, then the acceleration
+// vertices, then those near the object) and the tangent planes.
+struct FrameTerms {
+  LbsSubset sub;
+  std::vector<int> pen_rows;    // subset rows with a penetration plane
+  std::vector<Plane> pen;       // their planes
+  std::array<Plane, kJ> proj;   // per keypoint: the plane nearest K + D̂
+  std::vector<double> pos, jac;  // posed [3S] and d/dx [3S × 51] at the current point
+};
+
+struct HandData {
+  const HandModel* model = nullptr;
+  int64_t N = 0;
+  std::vector<double> x, beta;  // [N × 51], [10]
+  std::vector<double> H, D;     // targets, world frame [N × 300]
+  std::vector<ObjectState> states;
+  std::vector<int> kp_ids, acc_ids;  // vertex ids
+  std::vector<int> acc_rows;         // row of each acceleration vertex in every frame's subset
+  std::vector<FrameTerms> frames;
+  double s_fit = 0, s_proj = 0, s_pen = 0, s_acc = 0;  // residual scales (√weight/count)
+};
+
+// Poses every frame once per evaluation point, with Jacobians when asked.
+class PoseCache : public ceres::EvaluationCallback {
+ public:
+  explicit PoseCache(HandData* d) : d_(d) {}
+  void PrepareForEvaluation(bool jacobians, bool new_point) override {
+    if (!new_point && (have_jacobians_ || !jacobians)) return;
+    for (int64_t t = 0; t < d_->N; ++t) {
+      FrameTerms& f = d_->frames[static_cast<size_t>(t)];
+      const double* x = d_->x.data() + t * kX;
+      const int R = 3 * f.sub.size();
+      f.pos.resize(static_cast<size_t>(R));
+      if (jacobians) {
+        Jet xj[kX];
+        for (int i = 0; i < kX; ++i) xj[i] = Jet(x[i], i);
+        std::vector<Jet> out(static_cast<size_t>(R));
+        lbs_subset(f.sub, xj, xj + 3, xj + 48, d_->beta.data(), out.data());
+        f.jac.resize(static_cast<size_t>(R) * kX);
+        for (int r = 0; r < R; ++r) {
+          f.pos[static_cast<size_t>(r)] = out[static_cast<size_t>(r)].a;
+          std::copy(out[static_cast<size_t>(r)].v.data(), out[static_cast<size_t>(r)].v.data() + kX,
+                    f.jac.data() + static_cast<size_t>(r) * kX);
+        }
+      } else {
+        lbs_subset(f.sub, x, x + 3, x + 48, d_->beta.data(), f.pos.data());
+      }
+    }
+    have_jacobians_ = jacobians;
+  }
+
+ private:
+  HandData* d_;
+  bool have_jacobians_ = false;
+};
+
+// Row of the Jacobian of subset vertex s, coordinate k.
+inline const double* jac_row(const FrameTerms& f, int s, int k) {
+  return f.jac.data() + static_cast<size_t>(3 * s + k) * kX;
+}
+
+// A vertex moves with the global rotation and translation and with the fingers its
+// skinning weights (and pose correctives) reach. Each frame's state is split into Ceres
+// parameter blocks — rot (3), one per finger (9: its three joints), trans (3) — and every
+// residual block reads only the blocks its vertices move with: the normal equations
+// then skip the zeros a whole-hand block would carry (a fingertip row has 15 columns,
+// not 51), several times fewer operations.
+struct Block {
+  int offset, size;  // in the 51-vector
+};
+std::vector<Block> blocks_of(unsigned mask) {
+  std::vector<Block> b{{0, 3}};
+  for (int f = 0; f < 5; ++f)
+    if (mask & (1u << f)) b.push_back({3 + 9 * f, 9});
+  b.push_back({48, 3});
+  return b;
+}
+std::vector<double*> block_pointers(double* x, const std::vector<Block>& blocks) {
+  std::vector<double*> p;
+  for (const Block& b : blocks) p.push_back(x + b.offset);
+  return p;
+}
+
+// Per model vertex: bit f set when finger f (MANO order: index, middle, pinky, ring,
+// thumb; joints 1 + 3f .. 3 + 3f) moves it.
+std::vector<unsigned> finger_masks(const HandModel& m) {
+  const int V = m.num_vertices();
+  std::vector<unsigned> mask(static_cast<size_t>(V), 0u);
+  for (int i = 0; i < V; ++i)
+    for (int j = 1; j < HandModel::kNumJoints; ++j) {
+      bool moves = m.weights(i, j) != 0.0;
+      for (int e = 0; e < 9 && !moves; ++e)
+        for (int k = 0; k < 3 && !moves; ++k) moves = m.posedirs(3 * i + k, 9 * (j - 1) + e) != 0.0;
+      if (moves) mask[static_cast<size_t>(i)] |= 1u << ((j - 1) / 3);
+    }
+  return mask;
+}
+
+// Writes scale · (row vector `src`, 51 entries) into the residual row `row` of every block.
+inline void write_row(const double* src, double scale, const std::vector<Block>& blocks, int row, double** J,
+                      int first_block = 0) {
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    double* dst = J[first_block + static_cast<int>(b)];
+    if (!dst) continue;
+    dst += row * blocks[b].size;
+    for (int c = 0; c < blocks[b].size; ++c) dst[c] = scale * src[blocks[b].offset + c];
+  }
+}
+
+// Fit, projection and penetration rows of one frame's vertices that share a finger mask;
+// reads the cache.
+class FrameCost : public ceres::CostFunction {
+ public:
+  FrameCost(const HandData* d, int64_t t, std::vector<Block> blocks, std::vector<int> keypoints,
+            std::vector<int> pens)
+      : d_(d), t_(t), blocks_(std::move(blocks)), kps_(std::move(keypoints)), pens_(std::move(pens)) {
+    set_num_residuals(4 * static_cast<int>(kps_.size()) + static_cast<int>(pens_.size()));
+    for (const Block& b : blocks_) mutable_parameter_block_sizes()->push_back(b.size);
+  }
+  bool Evaluate(double const* const*, double* r, double** J) const override {
+    const FrameTerms& f = d_->frames[static_cast<size_t>(t_)];
+    const double* H = d_->H.data() + t_ * 3 * kJ;
+    const double* D = d_->D.data() + t_ * 3 * kJ;
+    double n_row[kX];
+    int row = 0;
+    for (int k : kps_)
+      for (int c = 0; c < 3; ++c, ++row) {
+        r[row] = d_->s_fit * (f.pos[static_cast<size_t>(3 * k + c)] - H[3 * k + c]);
+        if (J) write_row(jac_row(f, k, c), d_->s_fit, blocks_, row, J);
+      }
+    for (int k : kps_) {
+      const Plane& p = f.proj[static_cast<size_t>(k)];
+      const Eigen::Vector3d P(f.pos[3 * k] + D[3 * k], f.pos[3 * k + 1] + D[3 * k + 1], f.pos[3 * k + 2] + D[3 * k + 2]);
+      r[row] = d_->s_proj * p.normal.dot(P - p.point);
+      if (J) {
+        normal_row(f, k, p.normal, n_row);
+        write_row(n_row, d_->s_proj, blocks_, row, J);
+      }
+      ++row;
+    }
+    for (int i : pens_) {
+      const int s = f.pen_rows[static_cast<size_t>(i)];
+      const Plane& p = f.pen[static_cast<size_t>(i)];
+      const Eigen::Vector3d v(f.pos[3 * s], f.pos[3 * s + 1], f.pos[3 * s + 2]);
+      const double depth = p.normal.dot(p.point - v);
+      r[row] = depth > 0 ? d_->s_pen * depth : 0.0;
+      if (J) {
+        normal_row(f, s, p.normal, n_row);
+        write_row(n_row, depth > 0 ? -d_->s_pen : 0.0, blocks_, row, J);
+      }
+      ++row;
+    }
+    return true;
+  }
+
+ private:
+  static void normal_row(const FrameTerms& f, int s, const Eigen::Vector3d& n, double* dst) {
+    const double *a = jac_row(f, s, 0), *b = jac_row(f, s, 1), *c = jac_row(f, s, 2);
+    for (int i = 0; i < kX; ++i) dst[i] = n.x() * a[i] + n.y() * b[i] + n.z() * c[i];
+  }
+  const HandData* d_;
+  int64_t t_;
+  std::vector<Block> blocks_;
+  std::vector<int> kps_, pens_;  // keypoint indices; indices into the frame's pen rows
+};
+
+// Second differences over frames t−2, t−1, t of the acceleration vertices that share a
+// finger mask (the same subset rows in every frame).
+class AccelCost : public ceres::CostFunction {
+ public:
+  AccelCost(const HandData* d, int64_t t, std::vector<Block> blocks, std::vector<int> rows)
+      : d_(d), t_(t), blocks_(std::move(blocks)), rows_(std::move(rows)) {
+    set_num_residuals(3 * static_cast<int>(rows_.size()));
+    for (int i = 0; i < 3; ++i)
+      for (const Block& b : blocks_) mutable_parameter_block_sizes()->push_back(b.size);
+  }
+  bool Evaluate(double const* const*, double* r, double** J) const override {
+    const FrameTerms* f[3] = {&d_->frames[static_cast<size_t>(t_ - 2)], &d_->frames[static_cast<size_t>(t_ - 1)],
+                              &d_->frames[static_cast<size_t>(t_)]};
+    const double w[3] = {1.0, -2.0, 1.0};
+    const int nb = static_cast<int>(blocks_.size());
+    int row = 0;
+    for (int s : rows_)
+      for (int c = 0; c < 3; ++c, ++row) {
+        double v = 0;
+        for (int i = 0; i < 3; ++i) v += w[i] * f[i]->pos[static_cast<size_t>(3 * s + c)];
+        r[row] = d_->s_acc * v;
+        if (J)
+          for (int i = 0; i < 3; ++i) write_row(jac_row(*f[i], s, c), d_->s_acc * w[i], blocks_, row, J, i * nb);
+      }
+    return true;
+  }
+
+ private:
+  const HandData* d_;
+  int64_t t_;
+  std::vector<Block> blocks_;
+  std::vector<int> rows_;
+};
+
+using RowPoints = Points3;
+
+RowPoints pose_all(const LbsSubset& all, const double* x, const double* beta) {
+  RowPoints v(all.size(), 3);
+  lbs_subset(all, x, x + 3, x + 48, beta, v.data());
+  return v;
+}
+
+Plane plane_of(const ObjectSurfaceQuery& q) { return Plane{q.closest, q.normal}; }
+
+struct Evaluation {
+  RefineTerms terms;
+  double max_depth = 0;
+  double keypoint_error = 0;
+};
+
+// The cost's terms with exact distances at the current x; optionally re-linearises.
+Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dist,
+                    const RefineOptions& o, bool relinearise) {
+  const int64_t N = d->N;
+  const int V = all.size();
+  Evaluation e;
+  double proj = 0, pen = 0, acc = 0, fit = 0, kerr = 0;
+  std::vector<RowPoints> acc_points;
+  for (int64_t t = 0; t < N; ++t) {
+    const RowPoints v = pose_all(all, d->x.data() + t * kX, d->beta.data());
+    const ObjectState& st = d->states[static_cast<size_t>(t)];
+    const double* H = d->H.data() + t * 3 * kJ;
+    const double* D = d->D.data() + t * 3 * kJ;
+    FrameTerms* f = relinearise ? &d->frames[static_cast<size_t>(t)] : nullptr;
+    for (int k = 0; k < kJ; ++k) {
+      const Eigen::Vector3d K = v.row(d->kp_ids[static_cast<size_t>(k)]).transpose();
+      const Eigen::Vector3d Ht(H[3 * k], H[3 * k + 1], H[3 * k + 2]), Dt(D[3 * k], D[3 * k + 1], D[3 * k + 2]);
+      fit += (K - Ht).squaredNorm();
+      kerr += (K - Ht).norm();
+      const ObjectSurfaceQuery q = dist.query(st, K + Dt);
+      proj += q.signed_distance * q.signed_distance;
+      if (f) f->proj[static_cast<size_t>(k)] = plane_of(q);
+    }
+    const auto near = dist.near_surface(st, v, relinearise ? o.pen_margin : 0.0);
+    for (const auto& [i, q] : near)
+      if (q.signed_distance > 0) {
+        pen += q.signed_distance * q.signed_distance;
+        e.max_depth = std::max(e.max_depth, q.signed_distance);
+      }
+    RowPoints a(static_cast<Eigen::Index>(d->acc_ids.size()), 3);
+    for (size_t i = 0; i < d->acc_ids.size(); ++i) a.row(static_cast<Eigen::Index>(i)) = v.row(d->acc_ids[i]);
+    acc_points.push_back(std::move(a));
+    if (!f) continue;
+    // The frame's subset: keypoints, acceleration vertices, near vertices (no repeats).
+    std::vector<int> ids = d->kp_ids, row_of(static_cast<size_t>(V), -1);
+    for (int k = 0; k < kJ; ++k) row_of[static_cast<size_t>(ids[static_cast<size_t>(k)])] = k;
+    auto row_for = [&](int vid) {
+      int& r = row_of[static_cast<size_t>(vid)];
+      if (r < 0) {
+        r = static_cast<int>(ids.size());
+        ids.push_back(vid);
+      }
+      return r;
+    };
+    if (t == 0) {
+      d->acc_rows.clear();
+      for (int vid : d->acc_ids) d->acc_rows.push_back(row_for(vid));
+    } else {
+      for (int vid : d->acc_ids) row_for(vid);  // the same rows in every frame
+    }
+    f->pen_rows.clear();
+    f->pen.clear();
+    for (const auto& [i, q] : near) {
+      f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
+      f->pen.push_back(plane_of(q));
+    }
+    f->sub = LbsSubset::from(*d->model, ids);
+  }
+  for (int64_t t = 2; t < N; ++t)
+    acc += (acc_points[static_cast<size_t>(t)] - 2 * acc_points[static_cast<size_t>(t - 1)] +
+            acc_points[static_cast<size_t>(t - 2)]).rowwise().squaredNorm().sum();
+  const double nk = static_cast<double>(N * kJ);
+  e.terms.proj = o.w_proj * proj / nk;
+  e.terms.pen = o.w_pen * pen / static_cast<double>(N * V);
+  e.terms.fit = o.w_fit * fit / nk;
+  e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
+  e.keypoint_error = kerr / nk;
+  return e;
+}
+
+void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o, RefineHandReport* rep) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int V = d->model->num_vertices();
+  std::vector<int> all_ids(static_cast<size_t>(V));
+  for (int i = 0; i < V; ++i) all_ids[static_cast<size_t>(i)] = i;
+  const LbsSubset all = LbsSubset::from(*d->model, all_ids);
+  const std::vector<unsigned> masks = finger_masks(*d->model);
+  d->frames.assign(static_cast<size_t>(d->N), FrameTerms{});
+  const double nk = static_cast<double>(d->N * kJ);
+  d->s_fit = std::sqrt(2 * o.w_fit / nk);  // Ceres minimises ½Σr²
+  d->s_proj = std::sqrt(2 * o.w_proj / nk);
+  d->s_acc = d->N > 2 ? std::sqrt(2 * o.w_acc / static_cast<double>((d->N - 2) * static_cast<int64_t>(d->acc_ids.size())))
+                      : 0.0;
+
+  auto timed_evaluate = [&](bool relinearise) {
+    const auto s0 = std::chrono::steady_clock::now();
+    Evaluation ev = evaluate(d, all, dist, o, relinearise);
+    rep->surface_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+    return ev;
+  };
+  Evaluation e = timed_evaluate(o.outer_iterations > 0);
+  rep->before = e.terms;
+  rep->max_depth_before = e.max_depth;
+  double w_pen = o.w_pen;
+  const int max_outer = std::max(o.outer_iterations, o.max_outer_iterations);
+  for (int outer = 0; outer < max_outer; ++outer) {
+    if (outer >= o.outer_iterations) {
+      if (e.max_depth <= o.pen_tolerance || o.w_pen == 0) break;
+      w_pen *= o.pen_growth;
+    }
+    d->s_pen = std::sqrt(2 * w_pen / static_cast<double>(d->N * V));
+    PoseCache cache(d);
+    ceres::Problem::Options po;
+    po.evaluation_callback = &cache;
+    ceres::Problem problem(po);
+    // Acceleration rows by finger mask (the same in every frame).
+    std::map<unsigned, std::vector<int>> acc_groups;
+    for (size_t a = 0; a < d->acc_ids.size(); ++a)
+      acc_groups[masks[static_cast<size_t>(d->acc_ids[a])]].push_back(d->acc_rows[a]);
+    for (int64_t t = 0; t < d->N; ++t) {
+      const FrameTerms& f = d->frames[static_cast<size_t>(t)];
+      std::map<unsigned, std::pair<std::vector<int>, std::vector<int>>> groups;  // keypoints, pens
+      for (int k = 0; k < kJ; ++k) groups[masks[static_cast<size_t>(d->kp_ids[static_cast<size_t>(k)])]].first.push_back(k);
+      for (size_t i = 0; i < f.pen_rows.size(); ++i)
+        groups[masks[static_cast<size_t>(f.sub.vertex_ids[static_cast<size_t>(f.pen_rows[i])])]].second.push_back(
+            static_cast<int>(i));
+      double* x = d->x.data() + t * kX;
+      for (auto& [mask, g] : groups) {
+        const std::vector<Block> blocks = blocks_of(mask);
+        problem.AddResidualBlock(new FrameCost(d, t, blocks, std::move(g.first), std::move(g.second)), nullptr,
+                                 block_pointers(x, blocks));
+      }
+      if (t < 2 || o.w_acc == 0) continue;
+      for (const auto& [mask, rows] : acc_groups) {
+        const std::vector<Block> blocks = blocks_of(mask);
+        std::vector<double*> p;
+        for (int64_t u = t - 2; u <= t; ++u)
+          for (double* q : block_pointers(d->x.data() + u * kX, blocks)) p.push_back(q);
+        problem.AddResidualBlock(new AccelCost(d, t, blocks, rows), nullptr, p);
+      }
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    so.max_num_iterations = o.max_iterations;
+    so.num_threads = 1;  // one hand per thread
+    so.logging_type = ceres::SILENT;
+    so.function_tolerance = 1e-8;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    if (std::getenv("BIMART_DEBUG_REFINE")) {
+      size_t rows = 0, pens = 0;
+      for (const auto& f : d->frames) { rows += f.sub.size(); pens += f.pen_rows.size(); }
+      std::fprintf(stderr, "%s\n", summary.FullReport().c_str());
+      std::fprintf(stderr, "subset %.1f vertices, pen rows %.1f per frame\n", double(rows) / d->N, double(pens) / d->N);
+    }
+    rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
+    ++rep->outer_iterations;
+    e = timed_evaluate(true);
+  }
+  // The terms as defined, at the nominal w_pen.
+  rep->w_pen_final = w_pen;
+  rep->after = e.terms;
+  rep->max_depth_after = e.max_depth;
+  rep->keypoint_error_after = e.keypoint_error;
+  rep->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::vector<double> as_vector(const at::Tensor& t) {
+  const at::Tensor c = t.to(at::kCPU, at::kDouble).contiguous();
+  return std::vector<double>(c.data_ptr<double>(), c.data_ptr<double>() + c.numel());
+}
+
+}  // namespace
+
+void RefineOptions::validate() const {
+  auto nonneg = [](double v, const char* name) {
+    if (!(v >= 0) || !std::isfinite(v))
+      throw Error(std::string("refinement: ") + name + " must be a finite number >= 0");
+  };
+  nonneg(w_proj, "w_proj");
+  nonneg(w_pen, "w_pen");
+  nonneg(w_acc, "w_acc");
+  nonneg(w_fit, "w_fit");
+  nonneg(pen_margin, "pen_margin");
+  if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
+  if (max_outer_iterations < 0) throw Error("refinement: max_outer_iterations must be >= 0");
+  nonneg(pen_tolerance, "pen_tolerance");
+  if (!(pen_growth >= 1) || !std::isfinite(pen_growth)) throw Error("refinement: pen_growth must be >= 1");
+  if (max_iterations < 0) throw Error("refinement: max_iterations must be >= 0");
+  if (accel_vertices < 32) throw Error("refinement: accel_vertices must be >= 32 (2 per hand part)");
+  if (threads < 0) throw Error("refinement: threads must be >= 0 (0 = all cores)");
+}
+
+HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const ObjectDistance& distance, const at::Tensor& states,
+                        const at::Tensor& keypoints, const HandMotion& start,
+                        const RefineOptions& options, RefineReport* report) {
+  options.validate();
+  const int64_t N = start.num_frames();
+  if (N < 1) throw Error("refinement: the starting motion has no frames");
+  if (!keypoints.defined() || keypoints.dim() != 2 || keypoints.size(0) != N || keypoints.size(1) != kHandFeatureSize)
+    throw Error("refinement: keypoints must be [" + std::to_string(N) + ", 1200] to match the motion's frames");
+  if (!states.defined() || states.dim() != 2 || states.size(0) != N || states.size(1) != 7)
+    throw Error("refinement: object states must be [" + std::to_string(N) + ", 7]");
+  const at::Tensor X = keypoints.to(at::kCPU, at::kDouble).contiguous();
+  if (!at::isfinite(X).all().item<bool>()) throw Error("refinement: keypoints hold values that are not finite");
+  const auto t0 = std::chrono::steady_clock::now();
+  const HandKeypointsWorld w = hand_features_to_world(X, states.to(at::kCPU, at::kDouble).contiguous());
+  const at::Tensor st = states.to(at::kCPU, at::kDouble).contiguous();
+
+  std::array<HandData, 2> data;
+  for (int h = 0; h < 2; ++h) {
+    HandData& d = data[static_cast<size_t>(h)];
+    d.model = models[static_cast<size_t>(h)];
+    d.N = N;
+    states_from_hand_motion(start, h, &d.x, &d.beta);
+    d.H = as_vector(w.positions[h]);
+    d.D = as_vector(w.directions[h]);
+    for (int64_t t = 0; t < N; ++t) d.states.push_back(ObjectState::from_row(st[t].data_ptr<double>()));
+    d.kp_ids = model_keypoints(*d.model);
+    d.acc_ids = hand_keypoints(*d.model, options.accel_vertices);
+  }
+  RefineReport local;
+  const int threads = options.threads > 0 ? options.threads
+                                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  parallel_for(2, threads, [&](std::size_t h) { refine_hand(&data[h], distance, options, &local.hands[h]); });
+
+  HandMotion motion = hand_motion_from_states({data[0].x, data[1].x}, {data[0].beta, data[1].beta}, N);
+  motion.vertices = pose_hand_vertices(models, motion);
+  local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (report) *report = local;
+  return motion;
+}
+
+std::string format_refine_report(const RefineReport& r) {
+  std::string out;
+  for (int h = 0; h < 2; ++h) {
+    const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
+    out += fmt::format(
+        "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}; "
+        "deepest {:.1f} -> {:.1f} mm (w_pen {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
+        h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
+        x.after.acc, x.before.fit, x.after.fit, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.w_pen_final, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
+  }
+  return out;
+}
+
+}  // namespace bimart

@@ -1,0 +1,87 @@
+// Refining fitted hands against the object (paper §3.4 eq. 9–12, DESIGN §5), by Ceres over
+// all frames of each hand, starting from a MANO fit (core/refine/mano_fit.h).
+//
+// Cost per hand (each term a mean, so weights do not depend on counts):
+//   w_proj · mean_{t,k} dist(K_tk + D̂_tk, surface)²    keypoint + predicted direction on the surface
+//   w_pen  · Σ_{t, v inside} depth_tv² / (N·V)           hand vertices inside the object
+//   w_acc  · mean_{t,a} ||v_ta − 2 v_t−1,a + v_t−2,a||²  second differences of hand vertices
+//   w_fit  · mean_{t,k} ||K_tk − Ĥ_tk||²                 keypoints near the prediction (ours)
+// The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
+// converges, so it squares them and adds the fit term to hold what the other terms leave
+// free (a contact constrains a keypoint along the surface normal only). Its weights
+// w_proj = 100, w_pen = 10, w_acc = 1000 are the defaults; w_fit = 10 makes the
+// acceleration term a smoothing of ratio w_acc / w_fit = 100 (frame-to-frame jitter is
+// damped a thousandfold, a 1.5 s movement at 30 fps loses about 5 % of its amplitude)
+// and lets a contact outweigh a keypoint tenfold. Penetration is held under a tolerance
+// by growing w_pen (below).
+//
+// The object surface enters linearised: every outer iteration queries, per part in the
+// part's frame (CGAL AABB tree and inside test, core/object/object_distance.h), the
+// nearest surface point and normal of each projected keypoint and of each hand vertex
+// inside or near the object, and the inner Ceres solve works with those tangent planes.
+// The acceleration term uses `accel_vertices` vertices spread over the hand parts (the
+// mean over them estimates the mean over all vertices); β stays at the fit's value.
+// Per evaluation, each frame's vertices and Jacobians are posed once (Jets through
+// lbs_subset) and shared by all terms that read that frame.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include <ATen/core/Tensor.h>
+
+#include "core/hand/hand_model.h"
+#include "core/hand/hand_motion.h"
+#include "core/object/articulated_object.h"
+#include "core/object/object_distance.h"
+
+namespace bimart {
+
+struct RefineOptions {
+  double w_proj = 100, w_pen = 10, w_acc = 1000;  // DESIGN §5
+  double w_fit = 10;
+  int outer_iterations = 3;    // re-linearisations of the object surface
+  // Penetration is a constraint in effect: while the deepest vertex is deeper than
+  // pen_tolerance after an outer iteration, w_pen grows by pen_growth, for up to
+  // max_outer_iterations in all.
+  double pen_tolerance = 0.004;  // m: under the Pen 5mm threshold
+  double pen_growth = 4;
+  int max_outer_iterations = 6;
+  int max_iterations = 8;      // Levenberg–Marquardt steps per outer iteration
+  double pen_margin = 0.003;   // m: vertices closer than this to the surface get a plane
+  int accel_vertices = 48;     // vertices per hand in the acceleration term
+  int threads = 0;             // 0: all cores (the hands run in parallel)
+  void validate() const;       // throws bimart::Error naming the option
+};
+
+// The terms of the cost as defined above, weighted, with exact surface distances.
+struct RefineTerms {
+  double proj = 0, pen = 0, acc = 0, fit = 0;
+  double total() const { return proj + pen + acc + fit; }
+};
+struct RefineHandReport {
+  RefineTerms before, after;
+  double max_depth_before = 0, max_depth_after = 0;  // m, deepest vertex over all frames
+  double keypoint_error_after = 0;                   // m, mean ||K − Ĥ||
+  int iterations = 0;                                // LM steps over all outer iterations
+  int outer_iterations = 0;
+  double w_pen_final = 0;                            // w_pen after any growth
+  double seconds = 0;
+  double surface_seconds = 0;  // of which: surface queries and linearisation
+};
+struct RefineReport {
+  std::array<RefineHandReport, 2> hands;
+  double seconds = 0;
+};
+
+// keypoints X [N, 1200] (canonical frame, DESIGN §4), states [N, 7], start: a fit (world
+// frame), `distance`: the object's (built once per object). Returns the refined motion
+// with posed vertices. Throws bimart::Error for inputs whose shapes disagree.
+HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const ObjectDistance& distance, const at::Tensor& states,
+                        const at::Tensor& keypoints, const HandMotion& start,
+                        const RefineOptions& options = {}, RefineReport* report = nullptr);
+
+// One line per hand: the terms before → after, depth and keypoint error (for logs).
+std::string format_refine_report(const RefineReport& report);
+
+}  // namespace bimart

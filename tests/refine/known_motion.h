@@ -1,0 +1,56 @@
+// Test motions with a known answer: smooth random θ, β for both hands, posed by the
+// shipped models, and their keypoints with Gaussian noise.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <random>
+
+#include <ATen/ATen.h>
+
+#include "core/refine/hand_state.h"
+#include "core/refine/mano_fit.h"
+
+namespace bimart::test {
+
+// N frames; hands 20 cm apart, turning and curling slowly; β ~ N(0, 1).
+inline HandMotion known_motion(const std::array<const HandModel*, 2>& models, int N, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::array<std::vector<double>, 2> states, betas;
+  for (int h = 0; h < 2; ++h) {
+    std::vector<double> a(51), b(51), phase(51);
+    for (int i = 0; i < 51; ++i) {
+      a[i] = i < 3 ? 0.8 * g(rng) : (i < 48 ? models[h]->hands_mean[i - 3] + 0.2 * g(rng) : 0.05 * g(rng));
+      b[i] = i < 48 ? 0.15 * g(rng) : 0.02 * g(rng);
+      phase[i] = 6.28 * std::uniform_real_distribution<double>(0, 1)(rng);
+    }
+    a[48] += h == 0 ? -0.1 : 0.1;
+    states[h].resize(static_cast<size_t>(N) * 51);
+    for (int t = 0; t < N; ++t)
+      for (int i = 0; i < 51; ++i) states[h][t * 51 + i] = a[i] + b[i] * std::sin(0.15 * t + phase[i]);
+    betas[h].resize(10);
+    for (double& v : betas[h]) v = g(rng);
+  }
+  HandMotion m = hand_motion_from_states(states, betas, N);
+  m.vertices = pose_hand_vertices(models, m);
+  return m;
+}
+
+// [2, N, 100, 3] keypoints of `motion` plus N(0, sigma) per coordinate.
+inline at::Tensor noisy_keypoints(const std::array<const HandModel*, 2>& models, const HandMotion& motion,
+                                  double sigma_mm, unsigned seed) {
+  std::vector<at::Tensor> per_hand;
+  for (int h = 0; h < 2; ++h) {
+    const std::vector<int> ids = model_keypoints(*models[h]);
+    per_hand.push_back(motion.vertices[h].index_select(1, at::tensor(std::vector<int64_t>(ids.begin(), ids.end()))));
+  }
+  at::Tensor H = at::stack(per_hand).to(at::kDouble);
+  if (sigma_mm > 0) {
+    at::Generator gen = at::detail::createCPUGenerator(seed);
+    H = H + at::normal(0.0, sigma_mm * 1e-3, H.sizes(), gen, at::TensorOptions().dtype(at::kDouble));
+  }
+  return H.to(at::kFloat);
+}
+
+}  // namespace bimart::test

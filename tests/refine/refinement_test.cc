@@ -1,0 +1,143 @@
+// The refinement (core/refine/refinement.h) on cases with a known answer: a hand pushed
+// into a box comes out, a jittery sequence comes out smoother.
+#include "core/refine/refinement.h"
+
+#include <gtest/gtest.h>
+
+#include <ATen/ATen.h>
+#include <Eigen/Eigenvalues>
+
+#include "core/features/hand_features.h"
+#include "core/geometry/rotation.h"
+#include "core/metrics/accel.h"
+#include "core/object/families/primitives.h"
+#include "core/refine/hand_state.h"
+#include "core/refine/mano_fit.h"
+#include "core/util/error.h"
+#include "tests/refine/known_motion.h"
+#include "tests/synth/shipped_hands.h"
+
+namespace bimart {
+namespace {
+
+// A 40 × 40 × 10 cm slab (rounded edges) whose top face is z = 0 (bottom part) and a small lid far away.
+ArticulatedObject slab() {
+  ArticulatedObject o;
+  o.name = "slab";
+  // Dense (1 cm spacing): D points to the nearest object vertex, as on real objects.
+  o.bottom = shapes::rounded_box({-0.2, -0.2, -0.1}, {0.2, 0.2, 0.0}, 0.005, 0.01);
+  o.top = shapes::rounded_box({1.0, 1.0, 1.0}, {1.05, 1.05, 1.05}, 0.005, 0.01);
+  return o;
+}
+
+// Both hands lying flat on z = 0 (the thinnest direction of each flat hand turned to z),
+// 1 mm above it, side by side; N identical frames.
+HandMotion hands_on_the_slab(const std::array<const HandModel*, 2>& models, int N) {
+  std::array<std::vector<double>, 2> states, betas;
+  for (int h = 0; h < 2; ++h) {
+    std::vector<double> x(51, 0.0);
+    betas[h].assign(10, 0.0);
+    HandMotion one = hand_motion_from_states({x, x}, {betas[h], betas[h]}, 1);
+    at::Tensor v = pose_hand_vertices(models, one)[h][0].to(at::kDouble);
+    const Eigen::Map<const Points3> V(v.data_ptr<double>(), v.size(0), 3);
+    const Eigen::RowVector3d mean = V.colwise().mean();
+    const Eigen::Matrix3d C = (V.rowwise() - mean).transpose() * (V.rowwise() - mean);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+    const Eigen::Matrix3d R = rotation_between(eig.eigenvectors().col(0), Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d aa = matrix_to_axis_angle(R);
+    for (int k = 0; k < 3; ++k) x[k] = aa[k];
+    one = hand_motion_from_states({x, x}, {betas[h], betas[h]}, 1);
+    v = pose_hand_vertices(models, one)[h][0].to(at::kDouble);
+    const at::Tensor lo = std::get<0>(v.min(0)), hi = std::get<0>(v.max(0));
+    x[48] = (h == 0 ? -0.1 : 0.1) - 0.5 * (lo[0] + hi[0]).item<double>();
+    x[49] = -0.5 * (lo[1] + hi[1]).item<double>();
+    x[50] = 0.001 - lo[2].item<double>();
+    states[h].clear();
+    for (int t = 0; t < N; ++t) states[h].insert(states[h].end(), x.begin(), x.end());
+  }
+  HandMotion m = hand_motion_from_states(states, betas, N);
+  m.vertices = pose_hand_vertices(models, m);
+  return m;
+}
+
+std::vector<int> ids_of(const HandModel& m) { return model_keypoints(m); }
+
+TEST(Refinement, AHandPushedIntoABoxComesOutAndKeepsToTheKeypoints) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 6;
+  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
+  const HandMotion truth = hands_on_the_slab(models, N);
+  const at::Tensor X = hand_features(truth.vertices, ids_of(*models[1]), object, states);
+  // The prediction: keypoints 1.5 cm too deep, directions to the surface as they were.
+  auto [H, D] = split_hand_features(X);
+  const at::Tensor pushed = join_hand_features(H - at::tensor({0.0f, 0.0f, 0.015f}), D);
+  const HandMotion fit = fit_mano(models, hand_features_to_world(pushed, states).positions);
+
+  RefineReport report;
+  const HandMotion refined = refine_hands(models, distance, states, pushed, fit, {}, &report);
+  std::printf("%s", format_refine_report(report).c_str());
+  const at::Tensor true_kp = hand_features_to_world(X, states).positions.to(at::kDouble);
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_GT(report.hands[h].max_depth_before, 0.012);
+    EXPECT_LE(report.hands[h].max_depth_after, 0.002);
+    EXPECT_LT(report.hands[h].after.total(), report.hands[h].before.total());
+    const std::vector<int> ids = ids_of(*models[h]);
+    const at::Tensor kp = refined.vertices[h].index_select(1, at::tensor(std::vector<int64_t>(ids.begin(), ids.end())));
+    const double err = (kp.to(at::kDouble) - true_kp[h]).norm(2, {2}).mean().item<double>();
+    EXPECT_LT(err, 0.005) << "hand " << h << ": mean keypoint error " << err * 1e3 << " mm";
+  }
+  // Every vertex of the result checked again, independently of the report.
+  for (int t = 0; t < N; ++t)
+    for (int h = 0; h < 2; ++h) {
+      const at::Tensor v = refined.vertices[h][t].to(at::kDouble).contiguous();
+      const Eigen::Map<const Points3> V(v.data_ptr<double>(), v.size(0), 3);
+      EXPECT_LE(distance.max_signed_distance(ObjectState{}, V), 0.002);
+    }
+}
+
+TEST(Refinement, AJitterySequenceComesOutSmoother) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 20;
+  // Hands well above the slab: only the acceleration and fit terms act.
+  HandMotion truth = test::known_motion(models, N, 21);
+  for (auto& p : truth.hands) p.trans = p.trans + at::tensor({0.0f, 0.0f, 0.5f});
+  truth.vertices = pose_hand_vertices(models, truth);
+  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
+  at::Tensor H = test::noisy_keypoints(models, truth, 1.0, 22);
+  at::Generator gen = at::detail::createCPUGenerator(23);
+  H = H + at::normal(0.0, 0.004, {2, N, 1, 3}, gen);  // the whole hand jumps, frame to frame
+  const at::Tensor X = hand_features(H, [] {
+    std::vector<int> ids(100);
+    for (int i = 0; i < 100; ++i) ids[i] = i;
+    return ids;
+  }(), object, states);
+  const HandMotion fit = fit_mano(models, H);
+  RefineReport report;
+  const HandMotion refined = refine_hands(models, distance, states, X, fit, {}, &report);
+  std::printf("%s", format_refine_report(report).c_str());
+  const double a_fit = mean_acceleration(fit.vertices), a_ref = mean_acceleration(refined.vertices);
+  const double a_true = mean_acceleration(truth.vertices);
+  std::printf("Accel (m/frame²): truth %.3g, fit %.3g, refined %.3g\n", a_true, a_fit, a_ref);
+  EXPECT_LT(a_ref, 0.5 * a_fit);
+  const double err = (refined.vertices - truth.vertices).norm(2, {3}).mean().item<double>();
+  EXPECT_LT(err, 0.004);
+}
+
+TEST(Refinement, RejectsMismatchedInput) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const HandMotion m = hands_on_the_slab(models, 3);
+  EXPECT_THROW(refine_hands(models, distance, at::zeros({3, 7}), at::zeros({4, 1200}), m), Error);
+  EXPECT_THROW(refine_hands(models, distance, at::zeros({2, 7}), at::zeros({3, 1200}), m), Error);
+  RefineOptions bad;
+  bad.w_pen = -1;
+  EXPECT_THROW(refine_hands(models, distance, at::zeros({3, 7}), at::zeros({3, 1200}), m, bad), Error);
+}
+
+}  // namespace
+}  // namespace bimart
