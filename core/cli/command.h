@@ -26,4 +26,5 @@ void add_object_commands(CLI::App& app, Commands& out);    // object make, list,
 void add_hand_commands(CLI::App& app, Commands& out);      // hand make
 void add_eval_commands(CLI::App& app, Commands& out);      // eval
 void add_data_commands(CLI::App& app, Commands& out);      // data synth, data stats
+void add_refine_commands(CLI::App& app, Commands& out);    // refine
 }  // namespace bimart::cli

@@ -172,4 +172,13 @@ void save_hand_model(const HandModel& m, const std::string& npz_path) {
   npz.write(npz_path, NpzCompression::Deflate);
 }
 
+std::array<HandModel, 2> load_hand_models(const std::string& left_npz, const std::string& right_npz) {
+  std::array<HandModel, 2> m{load_hand_model(left_npz), load_hand_model(right_npz)};
+  for (int h = 0; h < 2; ++h)
+    if (m[static_cast<size_t>(h)].side != (h == 0 ? HandSide::Left : HandSide::Right))
+      throw Error((h == 0 ? left_npz : right_npz) + ": is a " + (h == 0 ? "right" : "left") + " hand, expected a " +
+                  (h == 0 ? "left" : "right") + " one");
+  return m;
+}
+
 }  // namespace bimart

@@ -40,6 +40,9 @@ struct HandModel {
 
 // Reads and validates a hand model .npz; throws bimart::Error naming the file and key.
 HandModel load_hand_model(const std::string& npz_path);
+// Both hands, {left, right}: load_hand_model of each, and an error naming the file when a
+// model is of the other side.
+std::array<HandModel, 2> load_hand_models(const std::string& left_npz, const std::string& right_npz);
 // Validates, then writes atomically (core/util/atomic_file.h).
 void save_hand_model(const HandModel& model, const std::string& npz_path);
 

@@ -25,11 +25,9 @@ struct PosingHands {
 std::shared_ptr<const PosingHands> load_posing_hands(const std::array<std::string, 2>& files) {
   auto hands = std::make_shared<PosingHands>();
   hands->files = files;
+  const std::array<HandModel, 2> models = load_hand_models(files[0], files[1]);
   for (int h = 0; h < 2; ++h) {
-    const HandModel model = load_hand_model(files[h]);
-    if (model.side != (h == 0 ? HandSide::Left : HandSide::Right))
-      throw Error(files[h] + ": is a " + (h == 0 ? "right" : "left") + " hand, expected a " +
-                  (h == 0 ? "left" : "right") + " one");
+    const HandModel& model = models[static_cast<size_t>(h)];
     hands->tensors[h] = HandModelTensors::from(model, at::kFloat);
     const std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
     hands->keypoints[h].assign(ids.begin(), ids.end());

@@ -252,19 +252,20 @@ HandMotion fit_mano(const std::array<const HandModel*, 2>& models, const at::Ten
   return motion;
 }
 
-at::Tensor pose_hand_vertices(const std::array<const HandModel*, 2>& models, const HandMotion& motion) {
+PosedHands pose_hands(const std::array<const HandModel*, 2>& models, const HandMotion& motion) {
   at::NoGradGuard no_grad;
   const int64_t N = motion.num_frames();
-  std::vector<at::Tensor> per_hand;
+  std::vector<at::Tensor> vertices, joints;
   for (int h = 0; h < 2; ++h) {
     const HandModelTensors m = HandModelTensors::from(*models[static_cast<size_t>(h)], at::kDouble);
     const HandParams& p = motion.hands[static_cast<size_t>(h)];
     auto d = [](const at::Tensor& t) { return t.to(at::kDouble).contiguous(); };
-    per_hand.push_back(
-        lbs(m, d(p.rot), d(p.pose), d(p.trans), d(p.shape).reshape({1, -1}).expand({N, -1}).contiguous())
-            .vertices.to(at::kFloat));
+    const LbsTensors r =
+        lbs(m, d(p.rot), d(p.pose), d(p.trans), d(p.shape).reshape({1, -1}).expand({N, -1}).contiguous());
+    vertices.push_back(r.vertices.to(at::kFloat));
+    joints.push_back(r.joints.to(at::kFloat));
   }
-  return at::stack(per_hand);
+  return {at::stack(vertices), at::stack(joints)};
 }
 
 }  // namespace bimart

@@ -57,8 +57,15 @@ struct ManoFitReport {
 HandMotion fit_mano(const std::array<const HandModel*, 2>& models, const at::Tensor& keypoints_world,
                     const ManoFitOptions& options = {}, ManoFitReport* report = nullptr);
 
-// Posed vertices [2, N, V, 3] float32 of a motion's parameters (full LBS).
-at::Tensor pose_hand_vertices(const std::array<const HandModel*, 2>& models, const HandMotion& motion);
+// Posed vertices [2, N, V, 3] and joints [2, N, 16, 3] (float32, world frame) of a
+// motion's parameters (full LBS, core/hand/lbs_torch.h).
+struct PosedHands {
+  at::Tensor vertices, joints;
+};
+PosedHands pose_hands(const std::array<const HandModel*, 2>& models, const HandMotion& motion);
+inline at::Tensor pose_hand_vertices(const std::array<const HandModel*, 2>& models, const HandMotion& motion) {
+  return pose_hands(models, motion).vertices;
+}
 
 // The keypoint vertex ids of a model: its stored ones, else computed (core/hand/keypoints.h).
 std::vector<int> model_keypoints(const HandModel& model);

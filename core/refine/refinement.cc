@@ -6,8 +6,6 @@
 #include <chrono>
 #include <map>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <thread>
 #include <vector>
 
@@ -20,6 +18,7 @@
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
 #include "core/util/error.h"
+#include "core/util/log.h"
 #include "core/util/parallel.h"
 
 namespace bimart {
@@ -40,6 +39,7 @@ struct FrameTerms {
   LbsSubset sub;
   std::vector<int> pen_rows;    // subset rows with a penetration plane
   std::vector<Plane> pen;       // their planes
+  std::vector<double> pen_scale;  // their residual scales (s_pen × the vertex's boost)
   std::array<Plane, kJ> proj;   // per keypoint: the plane nearest K + D̂
   std::vector<double> pos, jac;  // posed [3S] and d/dx [3S × 51] at the current point
 };
@@ -54,6 +54,8 @@ struct HandData {
   std::vector<int> acc_rows;         // row of each acceleration vertex in every frame's subset
   std::vector<FrameTerms> frames;
   double s_fit = 0, s_proj = 0, s_pen = 0, s_acc = 0;  // residual scales (√weight/count)
+  // Per frame: the penetration weight multiplier (grows while the frame stays too deep).
+  std::vector<double> pen_boost;
 };
 
 // Poses every frame once per evaluation point, with Jacobians when asked.
@@ -179,10 +181,11 @@ class FrameCost : public ceres::CostFunction {
       const Plane& p = f.pen[static_cast<size_t>(i)];
       const Eigen::Vector3d v(f.pos[3 * s], f.pos[3 * s + 1], f.pos[3 * s + 2]);
       const double depth = p.normal.dot(p.point - v);
-      r[row] = depth > 0 ? d_->s_pen * depth : 0.0;
+      const double scale = f.pen_scale[static_cast<size_t>(i)];
+      r[row] = depth > 0 ? scale * depth : 0.0;
       if (J) {
         normal_row(f, s, p.normal, n_row);
-        write_row(n_row, depth > 0 ? -d_->s_pen : 0.0, blocks_, row, J);
+        write_row(n_row, depth > 0 ? -scale : 0.0, blocks_, row, J);
       }
       ++row;
     }
@@ -248,11 +251,17 @@ struct Evaluation {
   RefineTerms terms;
   double max_depth = 0;
   double keypoint_error = 0;
+  double max_boost = 1;
+  int64_t deepest_frame = -1;
+  int deepest_vertex = -1;
+  double deepest_gap = 0;
+  int deepest_part = -1;
 };
 
 // The cost's terms with exact distances at the current x; optionally re-linearises.
+// With `grow`, vertices deeper than the tolerance get their penetration weight multiplied.
 Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dist,
-                    const RefineOptions& o, bool relinearise) {
+                    const RefineOptions& o, bool relinearise, bool grow = false) {
   const int64_t N = d->N;
   const int V = all.size();
   Evaluation e;
@@ -277,7 +286,13 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     for (const auto& [i, q] : near)
       if (q.signed_distance > 0) {
         pen += q.signed_distance * q.signed_distance;
-        e.max_depth = std::max(e.max_depth, q.signed_distance);
+        if (q.signed_distance > e.max_depth) {
+          e.max_depth = q.signed_distance;
+          e.deepest_frame = t;
+          e.deepest_vertex = i;
+          e.deepest_gap = (q.closest - v.row(i).transpose()).norm();
+          e.deepest_part = static_cast<int>(q.part);
+        }
       }
     RowPoints a(static_cast<Eigen::Index>(d->acc_ids.size()), 3);
     for (size_t i = 0; i < d->acc_ids.size(); ++i) a.row(static_cast<Eigen::Index>(i)) = v.row(d->acc_ids[i]);
@@ -302,9 +317,16 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     }
     f->pen_rows.clear();
     f->pen.clear();
+    f->pen_scale.clear();
+    double frame_depth = 0;
+    for (const auto& [i, q] : near) frame_depth = std::max(frame_depth, q.signed_distance);
+    double& boost = d->pen_boost[static_cast<size_t>(t)];
+    if (grow && frame_depth > o.pen_tolerance) boost *= o.pen_growth;
+    e.max_boost = std::max(e.max_boost, boost);
     for (const auto& [i, q] : near) {
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
       f->pen.push_back(plane_of(q));
+      f->pen_scale.push_back(d->s_pen * boost);
     }
     f->sub = LbsSubset::from(*d->model, ids);
   }
@@ -313,7 +335,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
             acc_points[static_cast<size_t>(t - 2)]).rowwise().squaredNorm().sum();
   const double nk = static_cast<double>(N * kJ);
   e.terms.proj = o.w_proj * proj / nk;
-  e.terms.pen = o.w_pen * pen / static_cast<double>(N * V);
+  e.terms.pen = o.w_pen * pen / nk;
   e.terms.fit = o.w_fit * fit / nk;
   e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
   e.keypoint_error = kerr / nk;
@@ -334,23 +356,21 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   d->s_acc = d->N > 2 ? std::sqrt(2 * o.w_acc / static_cast<double>((d->N - 2) * static_cast<int64_t>(d->acc_ids.size())))
                       : 0.0;
 
-  auto timed_evaluate = [&](bool relinearise) {
+  auto timed_evaluate = [&](bool relinearise, bool grow) {
     const auto s0 = std::chrono::steady_clock::now();
-    Evaluation ev = evaluate(d, all, dist, o, relinearise);
+    Evaluation ev = evaluate(d, all, dist, o, relinearise, grow);
     rep->surface_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
     return ev;
   };
-  Evaluation e = timed_evaluate(o.outer_iterations > 0);
+  d->s_pen = std::sqrt(2 * o.w_pen / nk);
+  d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
+  Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
   rep->before = e.terms;
   rep->max_depth_before = e.max_depth;
-  double w_pen = o.w_pen;
+  double max_boost = 1;
   const int max_outer = std::max(o.outer_iterations, o.max_outer_iterations);
   for (int outer = 0; outer < max_outer; ++outer) {
-    if (outer >= o.outer_iterations) {
-      if (e.max_depth <= o.pen_tolerance || o.w_pen == 0) break;
-      w_pen *= o.pen_growth;
-    }
-    d->s_pen = std::sqrt(2 * w_pen / static_cast<double>(d->N * V));
+    if (outer >= o.outer_iterations && (e.max_depth <= o.pen_tolerance || o.w_pen == 0)) break;
     PoseCache cache(d);
     ceres::Problem::Options po;
     po.evaluation_callback = &cache;
@@ -389,18 +409,22 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     so.function_tolerance = 1e-8;
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
-    if (std::getenv("BIMART_DEBUG_REFINE")) {
-      size_t rows = 0, pens = 0;
-      for (const auto& f : d->frames) { rows += f.sub.size(); pens += f.pen_rows.size(); }
-      std::fprintf(stderr, "%s\n", summary.FullReport().c_str());
-      std::fprintf(stderr, "subset %.1f vertices, pen rows %.1f per frame\n", double(rows) / d->N, double(pens) / d->N);
+    size_t rows = 0, pens = 0;
+    for (const FrameTerms& f : d->frames) {
+      rows += static_cast<size_t>(f.sub.size());
+      pens += f.pen_rows.size();
     }
     rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
     ++rep->outer_iterations;
-    e = timed_evaluate(true);
+    e = timed_evaluate(true, true);
+    max_boost = std::max(max_boost, e.max_boost);
+    log::debug("refinement round {} (largest penetration boost {:g}): {} vertices and {} penetration planes per frame; deepest {:.1f} mm "
+               "(frame {}, vertex {}, {:.1f} mm from its nearest surface point, part {}); {}",
+               outer + 1, max_boost, rows / static_cast<size_t>(d->N), pens / static_cast<size_t>(d->N),
+               e.max_depth * 1e3, e.deepest_frame, e.deepest_vertex, e.deepest_gap * 1e3, e.deepest_part, summary.BriefReport());
   }
   // The terms as defined, at the nominal w_pen.
-  rep->w_pen_final = w_pen;
+  rep->max_pen_boost = max_boost;
   rep->after = e.terms;
   rep->max_depth_after = e.max_depth;
   rep->keypoint_error_after = e.keypoint_error;
@@ -479,10 +503,10 @@ std::string format_refine_report(const RefineReport& r) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
         "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}; "
-        "deepest {:.1f} -> {:.1f} mm (w_pen {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
+        "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
         x.after.acc, x.before.fit, x.after.fit, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
-        x.w_pen_final, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
+        x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;
 }

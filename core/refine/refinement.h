@@ -1,9 +1,10 @@
 // Refining fitted hands against the object (paper §3.4 eq. 9–12, DESIGN §5), by Ceres over
 // all frames of each hand, starting from a MANO fit (core/refine/mano_fit.h).
 //
-// Cost per hand (each term a mean, so weights do not depend on counts):
+// Cost per hand (means over N frames and J = 100 keypoints or A acceleration vertices, so
+// weights do not depend on counts; penetration sums the inside vertices like the paper):
 //   w_proj · mean_{t,k} dist(K_tk + D̂_tk, surface)²    keypoint + predicted direction on the surface
-//   w_pen  · Σ_{t, v inside} depth_tv² / (N·V)           hand vertices inside the object
+//   w_pen  · Σ_{t, v inside} depth_tv² / (N·J)           hand vertices inside the object
 //   w_acc  · mean_{t,a} ||v_ta − 2 v_t−1,a + v_t−2,a||²  second differences of hand vertices
 //   w_fit  · mean_{t,k} ||K_tk − Ĥ_tk||²                 keypoints near the prediction (ours)
 // The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
@@ -13,7 +14,7 @@
 // acceleration term a smoothing of ratio w_acc / w_fit = 100 (frame-to-frame jitter is
 // damped a thousandfold, a 1.5 s movement at 30 fps loses about 5 % of its amplitude)
 // and lets a contact outweigh a keypoint tenfold. Penetration is held under a tolerance
-// by growing w_pen (below).
+// by growing the weights of the vertices that stay too deep (below).
 //
 // The object surface enters linearised: every outer iteration queries, per part in the
 // part's frame (CGAL AABB tree and inside test, core/object/object_distance.h), the
@@ -41,14 +42,17 @@ struct RefineOptions {
   double w_proj = 100, w_pen = 10, w_acc = 1000;  // DESIGN §5
   double w_fit = 10;
   int outer_iterations = 3;    // re-linearisations of the object surface
-  // Penetration is a constraint in effect: while the deepest vertex is deeper than
-  // pen_tolerance after an outer iteration, w_pen grows by pen_growth, for up to
-  // max_outer_iterations in all.
+  // Penetration is a constraint in effect: after every outer iteration, each frame whose
+  // deepest vertex is deeper than pen_tolerance has its penetration weight multiplied by
+  // pen_growth, and rounds go on past outer_iterations while one is, up to
+  // max_outer_iterations. (A few deep vertices weigh little beside the keypoints and the
+  // acceleration of a whole hand; growing the weight where needed moves them without
+  // stiffening the rest.)
   double pen_tolerance = 0.004;  // m: under the Pen 5mm threshold
-  double pen_growth = 4;
-  int max_outer_iterations = 6;
-  int max_iterations = 8;      // Levenberg–Marquardt steps per outer iteration
-  double pen_margin = 0.003;   // m: vertices closer than this to the surface get a plane
+  double pen_growth = 10;
+  int max_outer_iterations = 4;
+  int max_iterations = 4;      // Levenberg–Marquardt steps per outer iteration
+  double pen_margin = 0.01;    // m: vertices closer than this to the surface get a plane
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
   void validate() const;       // throws bimart::Error naming the option
@@ -65,7 +69,7 @@ struct RefineHandReport {
   double keypoint_error_after = 0;                   // m, mean ||K − Ĥ||
   int iterations = 0;                                // LM steps over all outer iterations
   int outer_iterations = 0;
-  double w_pen_final = 0;                            // w_pen after any growth
+  double max_pen_boost = 1;                          // largest weight multiplier reached
   double seconds = 0;
   double surface_seconds = 0;  // of which: surface queries and linearisation
 };

@@ -97,6 +97,30 @@ TEST(Refinement, AHandPushedIntoABoxComesOutAndKeepsToTheKeypoints) {
     }
 }
 
+// The penetration term alone (no projection, keypoints left where they were predicted):
+// the hand must still come out, to the tolerance.
+TEST(Refinement, PenetrationAlonePushesAHandOut) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 4;
+  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
+  const HandMotion truth = hands_on_the_slab(models, N);
+  const at::Tensor X = hand_features(truth.vertices, ids_of(*models[1]), object, states);
+  auto [H, D] = split_hand_features(X);
+  const at::Tensor pushed = join_hand_features(H - at::tensor({0.0f, 0.0f, 0.008f}), D);
+  const HandMotion fit = fit_mano(models, hand_features_to_world(pushed, states).positions);
+  RefineOptions o;
+  o.w_proj = 0;
+  RefineReport report;
+  refine_hands(models, distance, states, pushed, fit, o, &report);
+  std::printf("%s", format_refine_report(report).c_str());
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_GT(report.hands[h].max_depth_before, 0.006);
+    EXPECT_LE(report.hands[h].max_depth_after, o.pen_tolerance);
+  }
+}
+
 TEST(Refinement, AJitterySequenceComesOutSmoother) {
   const auto& models = test::shipped_hands();
   const ArticulatedObject object = slab();
