@@ -1,0 +1,82 @@
+// refine.ceres: the fitted hands refined against the object (paper eq. 9-12): projection
+// of keypoints plus direction vectors onto the surface, penetration, acceleration, by
+// Ceres with CGAL surface queries (core/refine/refinement.h). Starts from the previous
+// refiner's hand_params (refine.mano_fit); without one it fits first, with defaults.
+#include "core/features/hand_features.h"
+#include "core/object/object_distance.h"
+#include "core/pipeline/plugin.h"
+#include "core/refine/mano_fit.h"
+#include "core/refine/refinement.h"
+#include "core/util/log.h"
+#include "hand_models.h"
+#include "stages/refiner.h"
+
+namespace bimart {
+namespace {
+
+class CeresRefineStage : public Refiner {
+ public:
+  static StageSpec spec() {
+    RefineOptions d;
+    StageSpec s =
+        StageSpec::of<Refiner>("ceres", "refine the hands against the object: projection, penetration, acceleration (Ceres, CGAL)")
+            .param("w_proj", d.w_proj, "keypoint + predicted direction on the object surface (paper: 100)")
+            .param("w_pen", d.w_pen, "hand vertices inside the object (paper: 10); grows per frame while too deep")
+            .param("w_acc", d.w_acc, "second differences of hand vertices (paper: 1000)")
+            .param("w_fit", d.w_fit, "keypoints near the prediction (ours)")
+            .param("rounds", d.outer_iterations, "linearisations of the object surface")
+            .param("steps", d.max_iterations, "solver steps per round")
+            .param("max_rounds", d.max_outer_iterations, "rounds while a frame is deeper than pen_tolerance")
+            .param("pen_margin", d.pen_margin, "m: vertices this close to the surface get a penetration plane")
+            .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
+            .param("pen_growth", d.pen_growth, "factor of that growth per round")
+            .param("accel_vertices", d.accel_vertices, "hand vertices in the acceleration term (>= 32)")
+            .param("threads", d.threads, "0: all cores (one hand per thread)");
+    refine_plugin::declare_hand_params(s);
+    return s;
+  }
+
+  explicit CeresRefineStage(const Params& p) : hands_(refine_plugin::load_hand_pair(p)) {
+    o_.w_proj = p.number("w_proj");
+    o_.w_pen = p.number("w_pen");
+    o_.w_acc = p.number("w_acc");
+    o_.w_fit = p.number("w_fit");
+    o_.outer_iterations = static_cast<int>(p.integer("rounds"));
+    o_.max_iterations = static_cast<int>(p.integer("steps"));
+    o_.max_outer_iterations = static_cast<int>(p.integer("max_rounds"));
+    o_.pen_margin = p.number("pen_margin");
+    o_.pen_tolerance = p.number("pen_tolerance");
+    o_.pen_growth = p.number("pen_growth");
+    o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));
+    o_.threads = static_cast<int>(p.integer("threads"));
+    o_.validate();
+  }
+
+  void run(StageIO& io) override {
+    const at::Tensor& X = io.in<at::Tensor>("hand_keypoints");
+    const at::Tensor& states = io.in<at::Tensor>("object_states");
+    const ArticulatedObject& object = io.in<ArticulatedObject>("object");
+    const auto models = hands_->pointers();
+    HandMotion start;
+    if (io.has("hand_params")) {
+      start = io.in<HandMotion>("hand_params");
+    } else {
+      log::info("refine.ceres: no hand_params to start from; fitting MANO first (refine.mano_fit's defaults)");
+      start = fit_mano(models, hand_features_to_world(X, states).positions);
+    }
+    const ObjectDistance distance(object);
+    RefineReport report;
+    HandMotion motion = refine_hands(models, distance, states, X, start, o_, &report);
+    log::info("refine.ceres: {} frames in {:.2f} s\n{}", X.size(0), report.seconds, format_refine_report(report));
+    io.out("hand_params", std::move(motion));
+  }
+
+ private:
+  std::shared_ptr<const refine_plugin::HandPair> hands_;
+  RefineOptions o_;
+};
+
+}  // namespace
+}  // namespace bimart
+
+BIMART_REGISTER_STAGE(bimart::CeresRefineStage)

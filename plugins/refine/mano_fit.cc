@@ -1,0 +1,60 @@
+// refine.mano_fit: MANO-layout hands fitted to the generated keypoints H (paper eq. 8):
+// θ per frame and β per sequence for each hand, by Ceres (core/refine/mano_fit.h).
+#include <fmt/format.h>
+
+#include "core/features/hand_features.h"
+#include "core/pipeline/plugin.h"
+#include "core/refine/mano_fit.h"
+#include "core/util/log.h"
+#include "hand_models.h"
+#include "stages/refiner.h"
+
+namespace bimart {
+namespace {
+
+class ManoFitStage : public Refiner {
+ public:
+  static StageSpec spec() {
+    ManoFitOptions d;
+    StageSpec s = StageSpec::of<Refiner>("mano_fit", "fit MANO (θ per frame, β per sequence) to the keypoints H with Ceres")
+                      .param("w_pose", d.w_pose, "weak prior towards MANO's mean finger pose")
+                      .param("w_shape", d.w_shape, "weak prior towards β = 0")
+                      .param("w_smooth", d.w_smooth, "temporal smoothness: first differences of θ")
+                      .param("fit_shape", d.fit_shape, "fit β (false: β = 0)")
+                      .param("warm_start_iterations", d.warm_start_iterations, "solver steps per frame, frame by frame")
+                      .param("max_iterations", d.max_iterations, "solver steps of the joint solve over all frames")
+                      .param("threads", d.threads, "0: all cores (one hand per thread)");
+    refine_plugin::declare_hand_params(s);
+    return s;
+  }
+
+  explicit ManoFitStage(const Params& p) : hands_(refine_plugin::load_hand_pair(p)) {
+    o_.w_pose = p.number("w_pose");
+    o_.w_shape = p.number("w_shape");
+    o_.w_smooth = p.number("w_smooth");
+    o_.fit_shape = p.boolean("fit_shape");
+    o_.warm_start_iterations = static_cast<int>(p.integer("warm_start_iterations"));
+    o_.max_iterations = static_cast<int>(p.integer("max_iterations"));
+    o_.threads = static_cast<int>(p.integer("threads"));
+    o_.validate();
+  }
+
+  void run(StageIO& io) override {
+    const at::Tensor& X = io.in<at::Tensor>("hand_keypoints");
+    const at::Tensor& states = io.in<at::Tensor>("object_states");
+    ManoFitReport report;
+    HandMotion motion = fit_mano(hands_->pointers(), hand_features_to_world(X, states).positions, o_, &report);
+    log::info("mano_fit: {} frames, mean keypoint error {:.2f} / {:.2f} mm (left / right), {:.2f} s", X.size(0),
+              1e3 * report.hands[0].mean_keypoint_error, 1e3 * report.hands[1].mean_keypoint_error, report.seconds);
+    io.out("hand_params", std::move(motion));
+  }
+
+ private:
+  std::shared_ptr<const refine_plugin::HandPair> hands_;
+  ManoFitOptions o_;
+};
+
+}  // namespace
+}  // namespace bimart
+
+BIMART_REGISTER_STAGE(bimart::ManoFitStage)

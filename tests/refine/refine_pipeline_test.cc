@@ -1,0 +1,102 @@
+// refine.mano_fit and refine.ceres as pipeline stages, through the CLI: one synthetic
+// sequence, corrupted keypoints (motion.ground_truth), and two pipelines that differ by the
+// `refine` stage alone — the ablation rows "w C + CG" and "w C + CG + Opt". The refined
+// hands must be smoother and no deeper than the fitted ones; `bimart refine` on the same
+// folder must print its table.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <ATen/ATen.h>
+
+#include "core/io/sequence.h"
+#include "core/metrics/accel.h"
+#include "core/metrics/frame_depths.h"
+#include "core/metrics/hand_vertices.h"
+#include "core/object/object_io.h"
+
+namespace bimart {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::pair<int, std::string> run_cli(const std::string& args) {
+  const std::string cmd = std::string(BIMART_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  return {pclose(p), out};
+}
+
+std::string pipeline(const fs::path& sequence, const fs::path& out, bool refine) {
+  std::string y = "name: t\nseed: 0\nstages:\n"
+                  "  - id: sequence\n    use: trajectory.sequence\n    params: {path: \"" + sequence.string() + "\"}\n"
+                  "  - id: encoder\n    use: encoder.np_bps\n"
+                  "  - id: motion\n    use: motion.ground_truth\n    params: {seed: 3}\n"
+                  "  - id: fit\n    use: refine.mano_fit\n";
+  if (refine) y += "  - id: refine\n    use: refine.ceres\n";  // the one line between the rows
+  y += "  - id: write\n    use: export.sequence\n    params: {path: \"" + out.string() + "\"}\n";
+  return y;
+}
+
+TEST(RefinePipeline, TheRefineStageMakesTheFitSmootherAndNoDeeper) {
+  const fs::path dir = fs::temp_directory_path() / ("bimart_refine_pipeline_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  auto [status, out] = run_cli("data synth --out " + (dir / "data").string() +
+                               " --categories box --train-objects 1 --test-objects 0 --sequences 2 "
+                               "--min-frames 90 --max-frames 90 --quiet");
+  ASSERT_EQ(status, 0) << out;
+  fs::path sequence;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "data" / "sequences"))
+    if (e.path().extension() == ".npz" && (sequence.empty() || e.path() < sequence)) sequence = e.path();
+  ASSERT_FALSE(sequence.empty()) << out;
+
+  std::array<Sequence, 2> results;
+  for (int refine = 0; refine < 2; ++refine) {
+    const fs::path yaml = dir / (refine ? "refine.yaml" : "fit.yaml");
+    const fs::path result = dir / (refine ? "refined.npz" : "fitted.npz");
+    std::ofstream(yaml) << pipeline(sequence, result, refine);
+    auto [s, o] = run_cli("run " + yaml.string());
+    ASSERT_EQ(s, 0) << o;
+    if (refine) EXPECT_NE(o.find("refine.ceres: 90 frames"), std::string::npos) << o;
+    results[refine] = read_sequence(result.string());
+  }
+  const Sequence truth = read_sequence(sequence.string());
+  const ArticulatedObject object = load_object(resolve_object_path(truth, sequence.string()));
+  const ObjectDistance distance(object);
+  auto deepest = [&](const Sequence& s) {
+    const FrameDepths d = frame_depths(distance, s.object_states, hand_vertices(s.hands));
+    double m = -1;
+    for (size_t t = 0; t < d.size(); ++t) m = std::max(m, d.whole(t));
+    return m;
+  };
+  const double accel_fit = mean_acceleration(hand_vertices(results[0].hands));
+  const double accel_refined = mean_acceleration(hand_vertices(results[1].hands));
+  EXPECT_LT(accel_refined, 0.5 * accel_fit);
+  EXPECT_LT(accel_refined, 2 * mean_acceleration(hand_vertices(truth.hands)));
+  EXPECT_LE(deepest(results[1]), std::max(deepest(results[0]), 0.005));
+  // The written files are sequences `bimart eval` reads (their object paths resolve).
+  auto [es, eo] = run_cli("eval " + dir.string() + " --quiet");
+  EXPECT_EQ(es, 0) << eo;
+  EXPECT_NE(eo.find("generated (4)"), std::string::npos) << eo;
+
+  // The command behind docs/results.md on the same folder (one sequence).
+  auto [rs, ro] = run_cli("refine " + (dir / "data").string() + " --out " + (dir / "cli").string() + " --limit 1 --quiet");
+  ASSERT_EQ(rs, 0) << ro;
+  EXPECT_NE(ro.find("fit + refine (+ Opt)"), std::string::npos) << ro;
+  EXPECT_TRUE(fs::exists(dir / "cli" / "refined" / sequence.filename())) << ro;
+  fs::remove_all(dir);
+}
+
+TEST(RefinePipeline, RefuseAnUnknownKeypointSource) {
+  auto [s, o] = run_cli("refine . --keypoints predicted");
+  EXPECT_NE(s, 0);
+  EXPECT_NE(o.find("--keypoints"), std::string::npos) << o;
+}
+
+}  // namespace
+}  // namespace bimart
