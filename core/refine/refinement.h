@@ -10,11 +10,12 @@
 // The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
 // converges, so it squares them and adds the fit term to hold what the other terms leave
 // free (a contact constrains a keypoint along the surface normal only). Its weights
-// w_proj = 100, w_pen = 10, w_acc = 1000 are the defaults; w_fit = 10 makes the
-// acceleration term a smoothing of ratio w_acc / w_fit = 100 (frame-to-frame jitter is
-// damped a thousandfold, a 1.5 s movement at 30 fps loses about 5 % of its amplitude)
-// and lets a contact outweigh a keypoint tenfold. Penetration is held under a tolerance
-// by growing the weights of the vertices that stay too deep (below).
+// w_proj = 100, w_pen = 10, w_acc = 1000 are the defaults; w_fit = 30 makes the
+// acceleration term a smoothing of ratio w_acc / w_fit ≈ 33 (frame-to-frame jitter is
+// damped about 500-fold; a movement over 10 frames loses about a quarter of its
+// amplitude, one over 20 frames about 2 %)
+// and lets a contact outweigh a keypoint threefold. Penetration is held under a
+// tolerance by growing the penetration weight of the frames that stay too deep (below).
 //
 // The object surface enters linearised: every outer iteration queries, per part in the
 // part's frame (CGAL AABB tree and inside test, core/object/object_distance.h), the
@@ -40,7 +41,7 @@ namespace bimart {
 
 struct RefineOptions {
   double w_proj = 100, w_pen = 10, w_acc = 1000;  // DESIGN §5
-  double w_fit = 10;
+  double w_fit = 30;
   int outer_iterations = 3;    // re-linearisations of the object surface
   // Penetration is a constraint in effect: after every outer iteration, each frame whose
   // deepest vertex is deeper than pen_tolerance has its penetration weight multiplied by
@@ -48,7 +49,7 @@ struct RefineOptions {
   // max_outer_iterations. (A few deep vertices weigh little beside the keypoints and the
   // acceleration of a whole hand; growing the weight where needed moves them without
   // stiffening the rest.)
-  double pen_tolerance = 0.004;  // m: under the Pen 5mm threshold
+  double pen_tolerance = 0.002;  // m
   double pen_growth = 10;
   int max_outer_iterations = 4;
   int max_iterations = 4;      // Levenberg–Marquardt steps per outer iteration

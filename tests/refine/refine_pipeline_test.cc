@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include <ATen/ATen.h>
+#include <nlohmann/json.hpp>
 
 #include "core/io/sequence.h"
 #include "core/metrics/accel.h"
@@ -48,7 +49,7 @@ TEST(RefinePipeline, TheRefineStageMakesTheFitSmootherAndNoDeeper) {
   fs::remove_all(dir);
   auto [status, out] = run_cli("data synth --out " + (dir / "data").string() +
                                " --categories box --train-objects 1 --test-objects 0 --sequences 2 "
-                               "--min-frames 90 --max-frames 90 --quiet");
+                               "--min-frames 120 --max-frames 120 --quiet");
   ASSERT_EQ(status, 0) << out;
   fs::path sequence;
   for (const auto& e : fs::recursive_directory_iterator(dir / "data" / "sequences"))
@@ -62,7 +63,7 @@ TEST(RefinePipeline, TheRefineStageMakesTheFitSmootherAndNoDeeper) {
     std::ofstream(yaml) << pipeline(sequence, result, refine);
     auto [s, o] = run_cli("run " + yaml.string());
     ASSERT_EQ(s, 0) << o;
-    if (refine) EXPECT_NE(o.find("refine.ceres: 90 frames"), std::string::npos) << o;
+    if (refine) EXPECT_NE(o.find("refine.ceres: 120 frames"), std::string::npos) << o;
     results[refine] = read_sequence(result.string());
   }
   const Sequence truth = read_sequence(sequence.string());
@@ -84,11 +85,22 @@ TEST(RefinePipeline, TheRefineStageMakesTheFitSmootherAndNoDeeper) {
   EXPECT_EQ(es, 0) << eo;
   EXPECT_NE(eo.find("generated (4)"), std::string::npos) << eo;
 
-  // The command behind docs/results.md on the same folder (one sequence).
-  auto [rs, ro] = run_cli("refine " + (dir / "data").string() + " --out " + (dir / "cli").string() + " --limit 1 --quiet");
+  // The command behind docs/results.md on the same folder, with the bars.
+  auto [rs, ro] = run_cli("refine " + (dir / "data").string() + " --limit 1 --out " + (dir / "cli").string() +
+                          " --json " + (dir / "refine.json").string() + " --quiet");
   ASSERT_EQ(rs, 0) << ro;
   EXPECT_NE(ro.find("fit + refine (+ Opt)"), std::string::npos) << ro;
   EXPECT_TRUE(fs::exists(dir / "cli" / "refined" / sequence.filename())) << ro;
+  nlohmann::json j;
+  std::ifstream(dir / "refine.json") >> j;
+  const auto& rows = j["rows"];
+  const auto& gt = rows["ground truth"];
+  const auto& input = rows["input keypoints"];
+  const auto& refined = rows["fit + refine (+ Opt)"];
+  EXPECT_LE(refined["Pen 1cm"].get<double>(), gt["Pen 1cm"].get<double>() + 1.0) << ro;
+  EXPECT_LT(refined["Accel"].get<double>(), input["Accel"].get<double>()) << ro;
+  EXPECT_GE(refined["Con"].get<double>(), 95.0) << ro;
+  EXPECT_LT(j["joint_error_mm"]["refined"].get<double>(), 10.0) << ro;
   fs::remove_all(dir);
 }
 
