@@ -34,7 +34,7 @@ struct ManoFitOptions {
   double w_shape = 1e-3;   // shape prior towards β = 0
   double w_smooth = 1e-2;  // first differences of θ between frames
   bool fit_shape = true;   // false: β stays 0
-  int warm_start_iterations = 6;  // per frame, sequentially
+  int warm_start_iterations = 3;  // per frame, sequentially
   int max_iterations = 30;        // the joint solve
   int threads = 0;                // 0: all cores (the hands run in parallel)
   void validate() const;          // throws bimart::Error naming the option

@@ -259,7 +259,7 @@ struct Evaluation {
 };
 
 // The cost's terms with exact distances at the current x; optionally re-linearises.
-// With `grow`, vertices deeper than the tolerance get their penetration weight multiplied.
+// With `grow`, frames deeper than the tolerance get their penetration weight multiplied.
 Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dist,
                     const RefineOptions& o, bool relinearise, bool grow = false) {
   const int64_t N = d->N;

@@ -53,7 +53,7 @@ struct RefineOptions {
   double pen_growth = 10;
   int max_outer_iterations = 4;
   int max_iterations = 4;      // Levenberg–Marquardt steps per outer iteration
-  double pen_margin = 0.01;    // m: vertices closer than this to the surface get a plane
+  double pen_margin = 0.005;   // m: vertices closer than this to the surface get a plane
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
   void validate() const;       // throws bimart::Error naming the option
