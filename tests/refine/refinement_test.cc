@@ -62,18 +62,32 @@ HandMotion hands_on_the_slab(const std::array<const HandModel*, 2>& models, int 
 
 std::vector<int> ids_of(const HandModel& m) { return model_keypoints(m); }
 
+// Hands on the slab (the truth) and a prediction of them `depth` (m) too deep: keypoints
+// sunk, directions to the surface as they were; with its MANO fit.
+struct PushedHands {
+  at::Tensor states, X, pushed;
+  HandMotion truth, fit;
+};
+PushedHands pushed_into_the_slab(const ArticulatedObject& object, int N, float depth) {
+  const auto& models = test::shipped_hands();
+  PushedHands c;
+  c.states = at::zeros({N, 7}, at::kFloat);
+  c.truth = hands_on_the_slab(models, N);
+  c.X = hand_features(c.truth.vertices, ids_of(*models[1]), object, c.states);
+  auto [H, D] = split_hand_features(c.X);
+  c.pushed = join_hand_features(H - at::tensor({0.0f, 0.0f, depth}), D);
+  c.fit = fit_mano(models, hand_features_to_world(c.pushed, c.states).positions);
+  return c;
+}
+
 TEST(Refinement, AHandPushedIntoABoxComesOutAndKeepsToTheKeypoints) {
   const auto& models = test::shipped_hands();
   const ArticulatedObject object = slab();
   const ObjectDistance distance(object);
   const int N = 6;
-  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
-  const HandMotion truth = hands_on_the_slab(models, N);
-  const at::Tensor X = hand_features(truth.vertices, ids_of(*models[1]), object, states);
-  // The prediction: keypoints 1.5 cm too deep, directions to the surface as they were.
-  auto [H, D] = split_hand_features(X);
-  const at::Tensor pushed = join_hand_features(H - at::tensor({0.0f, 0.0f, 0.015f}), D);
-  const HandMotion fit = fit_mano(models, hand_features_to_world(pushed, states).positions);
+  const PushedHands c = pushed_into_the_slab(object, N, 0.015f);
+  const at::Tensor &states = c.states, &X = c.X, &pushed = c.pushed;
+  const HandMotion& fit = c.fit;
 
   RefineReport report;
   const HandMotion refined = refine_hands(models, distance, states, pushed, fit, {}, &report);
@@ -103,17 +117,11 @@ TEST(Refinement, PenetrationAlonePushesAHandOut) {
   const auto& models = test::shipped_hands();
   const ArticulatedObject object = slab();
   const ObjectDistance distance(object);
-  const int N = 4;
-  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
-  const HandMotion truth = hands_on_the_slab(models, N);
-  const at::Tensor X = hand_features(truth.vertices, ids_of(*models[1]), object, states);
-  auto [H, D] = split_hand_features(X);
-  const at::Tensor pushed = join_hand_features(H - at::tensor({0.0f, 0.0f, 0.008f}), D);
-  const HandMotion fit = fit_mano(models, hand_features_to_world(pushed, states).positions);
+  const PushedHands c = pushed_into_the_slab(object, 4, 0.008f);
   RefineOptions o;
   o.w_proj = 0;
   RefineReport report;
-  refine_hands(models, distance, states, pushed, fit, o, &report);
+  refine_hands(models, distance, c.states, c.pushed, c.fit, o, &report);
   std::printf("%s", format_refine_report(report).c_str());
   for (int h = 0; h < 2; ++h) {
     EXPECT_GT(report.hands[h].max_depth_before, 0.006);
