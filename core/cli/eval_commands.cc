@@ -172,7 +172,7 @@ struct EvalOptions {
 int eval(const EvalOptions& o) {
   if (o.folder.empty() && o.ground_truth.empty())
     throw Error("bimart eval: give a folder of sequences and/or --ground-truth DATASET");
-  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = resolve_threads(o.threads);
   // One sequence per thread: libtorch's own intra-op threads would only oversubscribe.
   runtime::set_threads(1);
   if (!o.mano_left.empty() || !o.mano_right.empty()) set_posing_hand_models(o.mano_left, o.mano_right);

@@ -64,10 +64,6 @@ struct PerSequence {
   RefineReport report;
 };
 
-at::Tensor select_keypoints(const at::Tensor& vertices, const std::vector<int>& ids) {
-  return vertices.index_select(2, at::tensor(std::vector<int64_t>(ids.begin(), ids.end())));
-}
-
 double mean_distance(const at::Tensor& a, const at::Tensor& b) {
   return (a.to(at::kDouble) - b.to(at::kDouble)).norm(2, {-1}).mean().item<double>();
 }
@@ -78,8 +74,7 @@ void write_result(const Sequence& in, const std::string& in_path, const HandMoti
   Sequence s = in;
   s.hands = hands;
   s.hands.vertices = at::Tensor();  // posed again on reading, as for every sequence
-  const fs::path object = fs::absolute(resolve_object_path(in, in_path));
-  s.object = fs::relative(object, fs::absolute(fs::path(out_path).parent_path())).string();
+  s.object = relative_object_path(resolve_object_path(in, in_path), out_path);
   fs::create_directories(fs::path(out_path).parent_path());
   write_sequence(s, out_path);
 }
@@ -154,7 +149,7 @@ int refine(RefineCliOptions o) {
   o.corruption.validate();
   std::vector<std::string> files = sequence_files(o.folder, o.split);
   if (o.limit > 0 && static_cast<size_t>(o.limit) < files.size()) files.resize(static_cast<size_t>(o.limit));
-  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = resolve_threads(o.threads);
   runtime::set_threads(1);  // one sequence per thread
 
   const std::string left = o.mano_left.empty() ? find_data_file("models/hand/mano_left.npz") : o.mano_left;

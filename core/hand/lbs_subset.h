@@ -22,13 +22,6 @@
 
 namespace bimart {
 
-struct LbsSubset;
-namespace lbs_detail {
-template <class T, class TV>
-void skin(const LbsSubset& m, const T (&GR)[HandModel::kNumJoints][9], const T (&At)[HandModel::kNumJoints][3],
-          const TV* v, const T* trans, T* out);
-}
-
 struct LbsSubset {
   std::vector<int> vertex_ids;  // rows of the full model, in this order
   // Row-major so that one vertex coordinate's blend shapes are contiguous.

@@ -158,6 +158,12 @@ void write_sequence(const Sequence& s, const std::string& path) {
   npz.write(path);  // atomic (NpzFile::write)
 }
 
+std::string relative_object_path(const std::string& object_path, const std::string& sequence_path) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::absolute(fs::path(sequence_path)).parent_path();
+  return fs::relative(fs::absolute(object_path), folder).string();
+}
+
 std::string resolve_object_path(const Sequence& sequence, const std::string& sequence_path) {
   const fs::path obj(sequence.object);
   if (obj.is_absolute()) return obj.lexically_normal().string();

@@ -237,9 +237,7 @@ HandMotion fit_mano(const std::array<const HandModel*, 2>& models, const at::Ten
 
   std::array<std::vector<double>, 2> states, betas;
   ManoFitReport local;
-  const int threads = options.threads > 0 ? options.threads
-                                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  parallel_for(2, threads, [&](std::size_t h) {
+  parallel_for(2, resolve_threads(options.threads), [&](std::size_t h) {
     const double* p = Hd[static_cast<int64_t>(h)].data_ptr<double>();
     const std::vector<double> targets(p, p + N * 3 * kJ);
     fit_hand(*models[h], targets, N, options, &states[h], &betas[h], &local.hands[h]);

@@ -237,10 +237,8 @@ class AccelCost : public ceres::CostFunction {
   std::vector<int> rows_;
 };
 
-using RowPoints = Points3;
-
-RowPoints pose_all(const LbsSubset& all, const double* x, const double* beta) {
-  RowPoints v(all.size(), 3);
+Points3 pose_all(const LbsSubset& all, const double* x, const double* beta) {
+  Points3 v(all.size(), 3);
   lbs_subset(all, x, x + 3, x + 48, beta, v.data());
   return v;
 }
@@ -254,8 +252,6 @@ struct Evaluation {
   double max_boost = 1;
   int64_t deepest_frame = -1;
   int deepest_vertex = -1;
-  double deepest_gap = 0;
-  int deepest_part = -1;
 };
 
 // The cost's terms with exact distances at the current x; optionally re-linearises.
@@ -266,9 +262,9 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   const int V = all.size();
   Evaluation e;
   double proj = 0, pen = 0, acc = 0, fit = 0, kerr = 0;
-  std::vector<RowPoints> acc_points;
+  std::vector<Points3> acc_points;
   for (int64_t t = 0; t < N; ++t) {
-    const RowPoints v = pose_all(all, d->x.data() + t * kX, d->beta.data());
+    const Points3 v = pose_all(all, d->x.data() + t * kX, d->beta.data());
     const ObjectState& st = d->states[static_cast<size_t>(t)];
     const double* H = d->H.data() + t * 3 * kJ;
     const double* D = d->D.data() + t * 3 * kJ;
@@ -290,11 +286,9 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
           e.max_depth = q.signed_distance;
           e.deepest_frame = t;
           e.deepest_vertex = i;
-          e.deepest_gap = (q.closest - v.row(i).transpose()).norm();
-          e.deepest_part = static_cast<int>(q.part);
         }
       }
-    RowPoints a(static_cast<Eigen::Index>(d->acc_ids.size()), 3);
+    Points3 a(static_cast<Eigen::Index>(d->acc_ids.size()), 3);
     for (size_t i = 0; i < d->acc_ids.size(); ++i) a.row(static_cast<Eigen::Index>(i)) = v.row(d->acc_ids[i]);
     acc_points.push_back(std::move(a));
     if (!f) continue;
@@ -367,7 +361,6 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
   rep->before = e.terms;
   rep->max_depth_before = e.max_depth;
-  double max_boost = 1;
   const int max_outer = std::max(o.outer_iterations, o.max_outer_iterations);
   for (int outer = 0; outer < max_outer; ++outer) {
     if (outer >= o.outer_iterations && (e.max_depth <= o.pen_tolerance || o.w_pen == 0)) break;
@@ -417,14 +410,13 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
     ++rep->outer_iterations;
     e = timed_evaluate(true, true);
-    max_boost = std::max(max_boost, e.max_boost);
     log::debug("refinement round {} (largest penetration boost {:g}): {} vertices and {} penetration planes per frame; deepest {:.1f} mm "
-               "(frame {}, vertex {}, {:.1f} mm from its nearest surface point, part {}); {}",
-               outer + 1, max_boost, rows / static_cast<size_t>(d->N), pens / static_cast<size_t>(d->N),
-               e.max_depth * 1e3, e.deepest_frame, e.deepest_vertex, e.deepest_gap * 1e3, e.deepest_part, summary.BriefReport());
+               "(frame {}, vertex {}); {}",
+               outer + 1, e.max_boost, rows / static_cast<size_t>(d->N), pens / static_cast<size_t>(d->N),
+               e.max_depth * 1e3, e.deepest_frame, e.deepest_vertex, summary.BriefReport());
   }
   // The terms as defined, at the nominal w_pen.
-  rep->max_pen_boost = max_boost;
+  rep->max_pen_boost = e.max_boost;  // boosts only grow: the last evaluation has the largest
   rep->after = e.terms;
   rep->max_depth_after = e.max_depth;
   rep->keypoint_error_after = e.keypoint_error;
@@ -470,8 +462,8 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
   const at::Tensor X = keypoints.to(at::kCPU, at::kDouble).contiguous();
   if (!at::isfinite(X).all().item<bool>()) throw Error("refinement: keypoints hold values that are not finite");
   const auto t0 = std::chrono::steady_clock::now();
-  const HandKeypointsWorld w = hand_features_to_world(X, states.to(at::kCPU, at::kDouble).contiguous());
   const at::Tensor st = states.to(at::kCPU, at::kDouble).contiguous();
+  const HandKeypointsWorld w = hand_features_to_world(X, st);
 
   std::array<HandData, 2> data;
   for (int h = 0; h < 2; ++h) {
@@ -486,9 +478,7 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
     d.acc_ids = hand_keypoints(*d.model, options.accel_vertices);
   }
   RefineReport local;
-  const int threads = options.threads > 0 ? options.threads
-                                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  parallel_for(2, threads, [&](std::size_t h) { refine_hand(&data[h], distance, options, &local.hands[h]); });
+  parallel_for(2, resolve_threads(options.threads), [&](std::size_t h) { refine_hand(&data[h], distance, options, &local.hands[h]); });
 
   HandMotion motion = hand_motion_from_states({data[0].x, data[1].x}, {data[0].beta, data[1].beta}, N);
   motion.vertices = pose_hand_vertices(models, motion);

@@ -122,7 +122,7 @@ SynthSummary synthesize_dataset(const SynthOptions& o) {
     throw Error("data synth: the hand models must be a left and a right hand");
   const std::array<const HandModel*, 2> models{&left, &right};
   prepare_folder(o);
-  const int threads = o.threads > 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  const int threads = resolve_threads(o.threads);
   at::set_num_threads(1);  // one sequence per thread
 
   // Objects: `train_objects` + `test_objects` instances of each category.

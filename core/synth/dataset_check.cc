@@ -39,7 +39,7 @@ DatasetCheck check_dataset(const std::string& folder, const std::string& split, 
   const std::array<HandModel, 2> model{
       load_hand_model(own ? mano_left : find_data_file("models/hand/mano_left.npz")),
       load_hand_model(own ? mano_right : find_data_file("models/hand/mano_right.npz"))};
-  threads = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = resolve_threads(threads);
   const int saved = at::get_num_threads();
   at::set_num_threads(1);
 

@@ -1,5 +1,6 @@
 #include "core/util/parallel.h"
 
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <mutex>
@@ -7,6 +8,11 @@
 #include <vector>
 
 namespace bimart {
+
+int resolve_threads(int threads) {
+  if (threads > 0) return threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
 
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& job) {
   std::atomic<std::size_t> next{0};

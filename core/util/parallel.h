@@ -9,6 +9,9 @@
 
 namespace bimart {
 
+// `threads` if positive, else the number of cores (at least 1).
+int resolve_threads(int threads);
+
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& job);
 
 }  // namespace bimart

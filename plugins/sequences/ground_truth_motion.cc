@@ -3,12 +3,9 @@
 // It stands where motion.diffusion will, so the refinement and exporters can be run and
 // measured before the generator exists; it ignores the object features it is wired to.
 #include "core/features/hand_features.h"
-#include "core/hand/hand_model.h"
 #include "core/metrics/hand_vertices.h"
 #include "core/pipeline/plugin.h"
-#include "core/refine/mano_fit.h"
 #include "core/synth/keypoint_corruption.h"
-#include "core/util/data_path.h"
 #include "stages/motion_generator.h"
 
 namespace bimart {
@@ -42,9 +39,10 @@ class GroundTruthMotion : public MotionGenerator {
   void run(StageIO& io) override {
     const at::Tensor& states = io.in<at::Tensor>("object_states");
     const HandMotion& truth = io.in<HandMotion>("ground_truth");
-    // Keypoint ids are the same for both hands (core/hand/keypoints.h).
-    static const std::vector<int> ids = model_keypoints(load_hand_model(find_data_file("models/hand/mano_right.npz")));
-    at::Tensor X = hand_features(hand_vertices(truth), ids, io.in<ArticulatedObject>("object"), states);
+    // The keypoints as posed for the metrics ([2, N, 100, 3]), given as "vertices" 0..99.
+    std::vector<int> ids(kHandKeypoints);
+    for (int k = 0; k < kHandKeypoints; ++k) ids[static_cast<size_t>(k)] = k;
+    at::Tensor X = hand_features(hand_keypoints(truth), ids, io.in<ArticulatedObject>("object"), states);
     if (corrupt_) X = corrupt_hand_features(X, io.in<double>("fps"), c_, static_cast<std::uint64_t>(seed_));
     io.out("hand_keypoints", X);
   }

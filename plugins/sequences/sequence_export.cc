@@ -31,9 +31,8 @@ class SequenceExport : public Exporter {
     s.object_states = io.in<at::Tensor>("object_states");
     s.hands = io.in<HandMotion>("hand_params");
     s.hands.vertices = at::Tensor();
-    const fs::path parent = fs::absolute(fs::path(path_)).parent_path();
-    fs::create_directories(parent);
-    s.object = fs::relative(fs::absolute(io.in<std::string>("object_path")), parent).string();
+    fs::create_directories(fs::absolute(fs::path(path_)).parent_path());
+    s.object = relative_object_path(io.in<std::string>("object_path"), path_);
     write_sequence(s, path_);
     io.out("path", path_);
   }

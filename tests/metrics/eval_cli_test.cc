@@ -13,25 +13,16 @@
 #include "core/util/data_path.h"
 #include "core/object/families/families.h"
 #include "core/object/object_io.h"
+#include "tests/cli/run_bimart.h"
 
 namespace bimart {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status;
-  std::string output;
-};
+using test::CliRun;
 
-CliRun run_cli(const std::string& args) {
-  const std::string cmd = std::string(BIMART_CLI) + " eval " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  return {pclose(p), out};
-}
+CliRun run_cli(const std::string& args) { return test::run_bimart("eval " + args); }
 
 // Hands hovering 2 cm above the closed box's lid at x = -0.05, moved by `offset` (m) in z.
 Sequence sequence(const std::string& name, const at::Tensor& states, double offset) {

@@ -18,20 +18,14 @@
 #include "core/metrics/frame_depths.h"
 #include "core/metrics/hand_vertices.h"
 #include "core/object/object_io.h"
+#include "tests/cli/run_bimart.h"
 
 namespace bimart {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::pair<int, std::string> run_cli(const std::string& args) {
-  const std::string cmd = std::string(BIMART_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  return {pclose(p), out};
-}
+test::CliRun run_cli(const std::string& args) { return test::run_bimart(args); }
 
 std::string pipeline(const fs::path& sequence, const fs::path& out, bool refine) {
   std::string y = "name: t\nseed: 0\nstages:\n"

@@ -1,0 +1,24 @@
+// Runs the `bimart` binary (BIMART_CLI, set by the test's CMakeLists.txt) with arguments,
+// for tests that drive whole commands.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+namespace bimart::test {
+
+struct CliRun {
+  int status;          // pclose()'s status: 0 on success
+  std::string output;  // stdout and stderr
+};
+
+inline CliRun run_bimart(const std::string& args) {
+  const std::string cmd = std::string(BIMART_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  return {pclose(p), out};
+}
+
+}  // namespace bimart::test
