@@ -1,0 +1,131 @@
+// Diffusion models on the CPU: training throughput (windows/s) per network size, sampling
+// one 64-frame window (contact + motion with CFG and contact-map guidance, 50 DDPM steps or
+// 10 DDIM steps; 1 or 10 samples), and one guidance step. Random weights: speed only.
+// Run: bimart_benchmarks --benchmark_filter=Diffusion   (docs/performance.md, "Diffusion")
+#include <benchmark/benchmark.h>
+
+#include <torch/optim/adam.h>
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+
+#include "core/diffusion/checkpoint.h"
+#include "core/diffusion/contact_guidance.h"
+#include "core/diffusion/generation.h"
+#include "core/diffusion/schedule.h"
+#include "core/runtime/blas.h"
+
+namespace bimart::diffusion {
+namespace {
+
+// Sizes tried: latent, layers, feed-forward, condition MLP width.
+DenoiserConfig sized(const std::string& model, int which) {
+  DenoiserConfig c = DenoiserConfig::paper(model);
+  const int table[4][4] = {{128, 4, 256, 128}, {256, 4, 512, 256}, {384, 6, 768, 384}, {512, 8, 1024, 1024}};
+  c.latent = table[which][0];
+  c.layers = table[which][1];
+  c.feedforward = table[which][2];
+  c.condition_hidden = table[which][3];
+  return c;
+}
+const char* size_name(int which) {
+  static const char* names[] = {"tiny", "small", "medium", "paper"};
+  return names[which];
+}
+
+void BM_DiffusionTrainStep(benchmark::State& state) {
+  runtime::set_threads(static_cast<int>(state.range(2)));
+  const std::string model = state.range(1) == 0 ? "contact" : "motion";
+  torch::manual_seed(0);
+  Denoiser net(sized(model, static_cast<int>(state.range(0))));
+  torch::optim::Adam opt(net->parameters(), torch::optim::AdamOptions(1e-4));
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const int B = 32;
+  const int S = net->config().sample_size;
+  const at::Tensor x0 = at::randn({B, 64, S}), obj = at::randn({B, 64, 3079});
+  const at::Tensor contact = model == "motion" ? at::randn({B, 64, 2048}) : at::Tensor();
+  const at::Tensor use = model == "motion" ? at::rand({B}) >= 0.5 : at::Tensor();
+  for (auto _ : state) {
+    const at::Tensor t = at::randint(0, 50, {B}, at::kLong);
+    const at::Tensor xt = add_noise(s, x0, at::randn_like(x0), t);
+    const at::Tensor loss = (net->forward(xt, t, net->encode_conditions(obj, contact, use)) - x0).pow(2).mean();
+    opt.zero_grad();
+    loss.backward();
+    opt.step();
+  }
+  state.SetItemsProcessed(state.iterations() * B);
+  state.SetLabel(std::string(size_name(static_cast<int>(state.range(0)))) + " " + model + ", " +
+                 std::to_string(net->num_parameters()) + " parameters");
+}
+BENCHMARK(BM_DiffusionTrainStep)
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}, {2}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(3.0)
+    ->UseRealTime();
+
+NormalizationStats unit_stats() {
+  NormalizationStats n;
+  n.variant = "np_bps";
+  n.count = 1;
+  n.x_mean = at::zeros({1200}, at::kDouble);
+  n.x_std = at::full({1200}, 0.05, at::kDouble);
+  n.obj_mean = at::zeros({3079}, at::kDouble);
+  n.obj_std = at::ones({3079}, at::kDouble);
+  n.c_mean = at::full({2048}, 0.05, at::kDouble);
+  n.c_std = at::full({2048}, 0.05, at::kDouble);
+  return n;
+}
+
+std::shared_ptr<const DiffusionModel> random_model(const std::string& kind, int which) {
+  Checkpoint c;
+  c.info.network = sized(kind, which);
+  c.info.network.dropout = 0.0;
+  c.info.basis_points = at::rand({1024, 3});
+  c.info.normalization = unit_stats();
+  torch::manual_seed(1);
+  Denoiser net(c.info.network);
+  c.weights = state_of(*net);
+  return std::make_shared<const DiffusionModel>(std::move(c), kind + " (random)");
+}
+
+// args: size, samples, DDIM steps (0 = DDPM 50)
+void BM_DiffusionSampleWindow(benchmark::State& state) {
+  runtime::set_threads(2);
+  const int which = static_cast<int>(state.range(0));
+  const auto contact = random_model("contact", which), motion = random_model("motion", which);
+  const at::Tensor O = at::randn({64, 1024, 3}), G = at::randn({64, 7});
+  const at::Tensor points = at::rand({64, 1024, 3}) * 0.2;
+  GenerateOptions o;
+  o.samples = static_cast<int>(state.range(1));
+  if (state.range(2) > 0) o.sampler = {"ddim", static_cast<int>(state.range(2)), 0.0};
+  auto gen = at::detail::createCPUGenerator(2);
+  for (auto _ : state) {
+    const at::Tensor C = contact->generate(O, G, {}, nullptr, o, gen);
+    const ContactMapGuidance guidance(points, C, 1.0);
+    benchmark::DoNotOptimize(motion->generate(O, G, C, &guidance, o, gen));
+  }
+  state.SetLabel(std::string(size_name(which)) + ", " + std::to_string(o.samples) + " samples, " +
+                 (state.range(2) > 0 ? "DDIM " + std::to_string(state.range(2)) : std::string("DDPM 50")));
+}
+BENCHMARK(BM_DiffusionSampleWindow)
+    ->Args({3, 1, 0})
+    ->Args({1, 1, 0})
+    ->Args({1, 10, 0})
+    ->Args({1, 1, 10})
+    ->Args({3, 1, 10})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_DiffusionGuidanceStep(benchmark::State& state) {
+  runtime::set_threads(static_cast<int>(state.range(0)));
+  const at::Tensor points = at::rand({64, 1024, 3}) * 0.2;
+  const at::Tensor target = at::rand({64, 2, 1024}) * 0.1;
+  const ContactMapGuidance g(points, target, 1.0);
+  const at::Tensor x0 = at::rand({1, 64, 1200}) * 0.2;
+  for (auto _ : state) benchmark::DoNotOptimize(g.correction(x0, 0, 10, 50));
+  state.SetLabel("64 frames, 1 sample");
+}
+BENCHMARK(BM_DiffusionGuidanceStep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace bimart::diffusion
