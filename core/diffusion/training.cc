@@ -81,13 +81,18 @@ std::uint64_t mix(std::uint64_t a, std::uint64_t b) {  // splitmix64 of a combin
 
 // Every random draw of a step comes from a seed of (config seed, step, rank): an
 // interrupted run resumes with identical batches, noise and dropout, and no random state
-// needs storing.
-void seed_step(std::uint64_t seed, std::int64_t step, int rank, std::mt19937_64& data_rng) {
+// needs storing. The windows come from `data_rng`, noise, steps and contact dropout from
+// the returned generator, the network's dropout from libtorch's default generator (seeded
+// here too; one training per process).
+at::Generator seed_step(std::uint64_t seed, std::int64_t step, int rank, std::mt19937_64& data_rng) {
   const std::uint64_t s = mix(mix(seed, static_cast<std::uint64_t>(step)), static_cast<std::uint64_t>(rank));
   data_rng.seed(s);
-  auto gen = at::detail::getDefaultCPUGenerator();
-  std::lock_guard<std::mutex> lock(gen.mutex());
-  gen.set_current_seed(mix(s, 17));
+  {
+    auto def = at::detail::getDefaultCPUGenerator();
+    std::lock_guard<std::mutex> lock(def.mutex());
+    def.set_current_seed(mix(s, 17));
+  }
+  return at::detail::createCPUGenerator(mix(s, 29));
 }
 
 std::string fmt_duration(double seconds) {
@@ -285,7 +290,8 @@ double learning_rate(const TrainConfig& c, std::int64_t step) {
 
 // ---- one step ----
 
-StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b) {
+StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b,
+                            at::Generator gen) {
   StepInputs in;
   const auto B = b.hand_features.size(0);
   in.object = stats.normalize_object(b.object_features, b.global_states);
@@ -294,11 +300,11 @@ StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stat
   } else {
     in.sample = stats.normalize_x(b.hand_features);
     in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
-    in.use_contact = at::rand({B}) >= c.contact_dropout;
+    in.use_contact = at::rand({B}, gen) >= c.contact_dropout;
   }
   in.mask = b.mask;
-  in.noise = at::randn(in.sample.sizes());
-  in.t = at::randint(0, c.diffusion_steps, {B}, at::kLong);
+  in.noise = at::randn(in.sample.sizes(), gen);
+  in.t = at::randint(0, c.diffusion_steps, {B}, gen, at::kLong);
   return in;
 }
 
@@ -316,8 +322,8 @@ LossParts step_loss(Denoiser& net, const NoiseSchedule& schedule, const StepInpu
 StepInputs draw_step(const TrainConfig& config, const NormalizationStats& stats, const WindowDataset& data,
                      std::int64_t step, int rank) {
   std::mt19937_64 rng;
-  seed_step(config.seed, step, rank, rng);
-  return make_step_inputs(config, stats, data.sample_batch(config.batch, rng));
+  at::Generator gen = seed_step(config.seed, step, rank, rng);
+  return make_step_inputs(config, stats, data.sample_batch(config.batch, rng), gen);
 }
 
 std::string data_fingerprint(const std::string& folder) {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include <ATen/core/Generator.h>
 #include <ATen/core/Tensor.h>
 
 #include "core/diffusion/denoiser.h"
@@ -96,10 +97,10 @@ struct StepInputs {
   at::Tensor noise;      // [B, T, S]
   at::Tensor t;          // [B] int64
 };
-// Builds StepInputs from a batch: normalisation, noise, steps and contact dropout drawn
-// from libtorch's default generator.
+// Builds StepInputs from a batch: normalisation, and noise, steps and contact dropout
+// drawn from `gen`.
 StepInputs make_step_inputs(const TrainConfig& config, const NormalizationStats& stats,
-                            const WindowBatch& batch);
+                            const WindowBatch& batch, at::Generator gen);
 // The inputs of training step `step` on process `rank`: every random draw (the windows,
 // noise, steps, contact dropout, and the network's dropout that follows) is seeded from
 // (config.seed, step, rank), so a resumed run draws exactly what an uninterrupted one did.

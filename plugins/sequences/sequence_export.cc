@@ -18,7 +18,7 @@ class SequenceExport : public Exporter {
         .input<double>("fps", "frames per second")
         .input<std::string>("object_path", "the object's folder or YAML (stored relative to the file)")
         .optional_input<at::Tensor>("contact_maps", "[N, 2, 1024] the contact maps that conditioned the motion (CM metric)")
-        .optional_input<at::Tensor>("basis_hit_indices", "[N, 1024] the encoder's hit vertices, stored with contact_maps")
+        .optional_input<at::Tensor>("basis_hit_indices", "[N, 1024] the encoder's hit vertices, stored when contact_maps is wired too")
         .param("path", "out/sequence.npz", "file to write (folders are created)")
         .param("name", "", "sequence name stored in the file (default: the file's stem)");
   }
@@ -33,9 +33,8 @@ class SequenceExport : public Exporter {
     s.object_states = io.in<at::Tensor>("object_states");
     s.hands = io.in<HandMotion>("hand_params");
     s.hands.vertices = at::Tensor();
-    if (io.has("contact_maps") != io.has("basis_hit_indices"))
-      throw Error("export.sequence: wire contact_maps and basis_hit_indices together (or neither)");
-    if (io.has("contact_maps")) {
+    // Stored when both are wired (an encoder alone wires the hit indices by name).
+    if (io.has("contact_maps") && io.has("basis_hit_indices")) {
       s.contact_maps = io.in<at::Tensor>("contact_maps");
       s.basis_hit_indices = io.in<at::Tensor>("basis_hit_indices");
     }
