@@ -27,4 +27,5 @@ void add_hand_commands(CLI::App& app, Commands& out);      // hand make
 void add_eval_commands(CLI::App& app, Commands& out);      // eval
 void add_data_commands(CLI::App& app, Commands& out);      // data synth, data stats
 void add_refine_commands(CLI::App& app, Commands& out);    // refine
+void add_export_commands(CLI::App& app, Commands& out);    // export, view, render
 }  // namespace bimart::cli
