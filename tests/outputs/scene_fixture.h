@@ -19,15 +19,15 @@
 namespace bimart::test {
 
 // The shipped hand with made-up correctives: column (joint j, entry e) moves each vertex along
-// its normal by up to 3 mm, in proportion to its weight on joint j.
+// its normal by up to 4.5 mm per unit of (R - I), in proportion to its weight on joint j.
 inline HandModel with_correctives(HandModel m) {
   TriangleMesh mesh{m.v_template, m.faces};
   const Eigen::MatrixX3d n = vertex_normals(mesh);
   for (int c = 0; c < HandModel::kNumPoseFeatures; ++c) {
     const int j = 1 + c / 9, e = c % 9;
-    const double sign = (e % 3) - 1.0 + 0.5 * (e / 3 - 1);
+    const double sign = (e - 4) + 0.5;  // never zero: every column is a target
     for (int v = 0; v < m.num_vertices(); ++v)
-      for (int k = 0; k < 3; ++k) m.posedirs(3 * v + k, c) = 0.003 * sign * m.weights(v, j) * n(v, k);
+      for (int k = 0; k < 3; ++k) m.posedirs(3 * v + k, c) = 0.001 * sign * m.weights(v, j) * n(v, k);
   }
   return m;
 }
