@@ -180,7 +180,7 @@ void add_object(Builder& b, Animation& anim, const ArticulatedObject& object, co
     p.material = material;
     p.mode = TINYGLTF_MODE_TRIANGLES;
     tinygltf::Mesh m;
-    m.name = name;
+    m.name = name + "_mesh";
     m.primitives.push_back(p);
     b.model.meshes.push_back(m);
     return static_cast<int>(b.model.meshes.size()) - 1;
@@ -264,26 +264,48 @@ int add_hand(Builder& b, Animation& anim, const HandModel& m, const HandParams& 
   prim.material = h == 0 ? b.material("left_hand", {0.93, 0.74, 0.62}, 0.5) : b.material("right_hand", {0.72, 0.50, 0.40}, 0.5);
   prim.mode = TINYGLTF_MODE_TRIANGLES;
 
-  // Pose correctives: one morph target per non-zero column of posedirs.
-  std::vector<int> columns;
-  if (options.correctives)
-    for (int c = 0; c < HandModel::kNumPoseFeatures; ++c)
-      if (m.posedirs.col(c).cwiseAbs().maxCoeff() > 0) columns.push_back(c);
-  std::vector<std::string> target_names;
-  for (int c : columns) {
-    std::vector<float> d(3 * V);
-    for (int i = 0; i < 3 * V; ++i) d[i] = static_cast<float>(m.posedirs(i, c));
-    prim.targets.push_back({{"POSITION", b.floats(d, TINYGLTF_TYPE_VEC3, kArrayBuffer, true)}});
-    const int joint = 1 + c / 9, e = c % 9;
-    target_names.push_back(fmt::format("{}_R{}{}", kJointNames[joint], e / 3, e % 3));
+  // Pose correctives. Feature c per frame is the entry (R_j - I)_e the corrective column c of
+  // posedirs is weighted by. One morph target per column that is non-zero and used by the
+  // motion, scaled so that its weight stays in [0, 1]: target = hi * D_c with weight f / hi
+  // for f >= 0, and a second target lo * D_c with weight f / lo for a column whose feature
+  // also goes negative. Exact at every frame; and Blender 3.4's importer, which clamps
+  // shape-key values to [min(0, first keyframe), 1], then reproduces it too.
+  std::vector<std::vector<double>> features(HandModel::kNumPoseFeatures, std::vector<double>(n));
+  for (std::int64_t t = 0; t < n; ++t) {
+    const double* th = pose[t].data_ptr<double>();
+    for (int j = 1; j < kJ; ++j) {
+      double R[9];
+      axis_angle_to_matrix(th + 3 * (j - 1), R);
+      for (int e = 0; e < 9; ++e) features[9 * (j - 1) + e][t] = R[e] - (e % 4 == 0 ? 1.0 : 0.0);
+    }
   }
-  summary.morph_targets[h] = static_cast<int>(columns.size());
+  struct Target {
+    int column;
+    double scale;  // the target is scale * D_c; its weight max(0, f / scale)
+  };
+  std::vector<Target> targets;
+  if (options.correctives)
+    for (int c = 0; c < HandModel::kNumPoseFeatures; ++c) {
+      if (!(m.posedirs.col(c).cwiseAbs().maxCoeff() > 0)) continue;
+      const auto [lo, hi] = std::minmax_element(features[c].begin(), features[c].end());
+      if (*hi > 0) targets.push_back({c, *hi});
+      if (*lo < 0) targets.push_back({c, *lo});
+    }
+  std::vector<std::string> target_names;
+  for (const Target& tg : targets) {
+    std::vector<float> d(3 * V);
+    for (int i = 0; i < 3 * V; ++i) d[i] = static_cast<float>(tg.scale * m.posedirs(i, tg.column));
+    prim.targets.push_back({{"POSITION", b.floats(d, TINYGLTF_TYPE_VEC3, kArrayBuffer, true)}});
+    const int joint = 1 + tg.column / 9, e = tg.column % 9;
+    target_names.push_back(fmt::format("{}_R{}{}{}", kJointNames[joint], e / 3, e % 3, tg.scale > 0 ? '+' : '-'));
+  }
+  summary.morph_targets[h] = static_cast<int>(targets.size());
 
   tinygltf::Mesh mesh;
-  mesh.name = side + "_hand";
+  mesh.name = side + "_hand_mesh";
   mesh.primitives.push_back(prim);
-  if (!columns.empty()) {
-    mesh.weights.assign(columns.size(), 0.0);
+  if (!targets.empty()) {
+    mesh.weights.assign(targets.size(), 0.0);
     tinygltf::Value::Array names;
     for (const auto& t : target_names) names.emplace_back(t);
     tinygltf::Value::Object extras;
@@ -312,17 +334,22 @@ int add_hand(Builder& b, Animation& anim, const HandModel& m, const HandParams& 
     ibm.insert(ibm.end(), cols, cols + 16);
   }
   tinygltf::Skin skin;
-  skin.name = side + "_hand";
+  skin.name = side + "_hand_skin";
   skin.inverseBindMatrices = b.floats(ibm, TINYGLTF_TYPE_MAT4, 0, false);
   skin.skeleton = node_ids[0];
   skin.joints.assign(node_ids.begin(), node_ids.end());
   b.model.skins.push_back(skin);
 
+  // The skeleton under its own group node, so that importers (Blender) make one armature per
+  // hand; the skinned mesh node at the scene root (its own transform would be ignored).
+  tinygltf::Node rig;
+  rig.name = side + "_hand_rig";
+  rig.children = {node_ids[0]};
+  roots.push_back(b.node(rig));
   tinygltf::Node mesh_node;
   mesh_node.name = side + "_hand";
   mesh_node.mesh = mesh_id;
   mesh_node.skin = static_cast<int>(b.model.skins.size()) - 1;
-  roots.push_back(node_ids[0]);
   roots.push_back(b.node(mesh_node));
 
   // Animation: per frame the 16 rotations, the root translation and the corrective weights.
@@ -331,21 +358,14 @@ int add_hand(Builder& b, Animation& anim, const HandModel& m, const HandParams& 
   for (std::int64_t t = 0; t < n; ++t) {
     push_quaternion(rotations[0], quaternion_of(rot[t].data_ptr<double>()));
     const double* th = pose[t].data_ptr<double>();
-    double R[kJ][9];
-    for (int j = 1; j < kJ; ++j) {
-      push_quaternion(rotations[j], quaternion_of(th + 3 * (j - 1)));
-      axis_angle_to_matrix(th + 3 * (j - 1), R[j]);
-    }
+    for (int j = 1; j < kJ; ++j) push_quaternion(rotations[j], quaternion_of(th + 3 * (j - 1)));
     const double* tr = trans[t].data_ptr<double>();
     for (int k = 0; k < 3; ++k) root_translation.push_back(static_cast<float>(J(0, k) + tr[k]));
-    for (int c : columns) {
-      const int j = 1 + c / 9, e = c % 9;
-      morph.push_back(static_cast<float>(R[j][e] - (e % 4 == 0 ? 1.0 : 0.0)));
-    }
+    for (const Target& tg : targets) morph.push_back(static_cast<float>(std::max(0.0, features[tg.column][t] / tg.scale)));
   }
   anim.channel(b, node_ids[0], "translation", root_translation, TINYGLTF_TYPE_VEC3);
   for (int j = 0; j < kJ; ++j) anim.channel(b, node_ids[j], "rotation", rotations[j], TINYGLTF_TYPE_VEC4);
-  if (!columns.empty()) anim.channel(b, roots.back(), "weights", morph, TINYGLTF_TYPE_SCALAR);
+  if (!targets.empty()) anim.channel(b, roots.back(), "weights", morph, TINYGLTF_TYPE_SCALAR);
   return mesh_id;
 }
 

@@ -14,15 +14,16 @@
 namespace bimart {
 
 struct GltfOptions {
-  // MANO's pose-corrective blend shapes as morph targets (one per non-zero posedirs column,
-  // weight = that entry of (R_j - I) per frame). Off: lighter files, LBS only.
+  // MANO's pose-corrective blend shapes as morph targets: per non-zero posedirs column the
+  // motion uses, one target (two when its weight (R_j - I)_e changes sign), scaled so that
+  // animated weights stay in [0, 1] (docs/outputs.md). Off: lighter files, LBS only.
   bool correctives = true;
 };
 
 // What a scene holds, for reports and tests.
 struct GltfSummary {
   std::int64_t frames = 0;
-  std::array<int, 2> morph_targets{};  // per hand
+  std::array<int, 2> morph_targets{};  // per hand (up to 2 x 135)
   std::array<int, 2> influences{};     // largest number of joints weighting one vertex, per hand
 };
 

@@ -7,6 +7,12 @@ import json
 import sys
 
 import bpy
+import numpy
+
+# Debian 12's Blender 3.4 glTF importer uses numpy.bool, which its numpy 1.24 removed
+# (KhronosGroup/glTF-Blender-IO#1844, fixed in Blender 3.5): restore the alias.
+if "bool" not in numpy.__dict__:
+    numpy.bool = bool
 
 glb, fps, out, frames = sys.argv[sys.argv.index("--") + 1:]
 fps = float(fps)
