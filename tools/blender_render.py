@@ -65,7 +65,8 @@ scene.world = world
 
 scene.render.engine = "CYCLES"
 scene.cycles.device = "CPU"
-scene.cycles.samples = 32
+scene.cycles.samples = 48
+scene.cycles.use_denoising = False  # Debian builds Cycles without OpenImageDenoise
 scene.render.resolution_x = scene.render.resolution_y = size
 scene.render.filepath = out
 bpy.ops.render.render(write_still=True)

@@ -62,10 +62,10 @@ std::string html_escape(const std::string& s) {
 constexpr const char* kStyle = R"(
 html, body { margin: 0; height: 100%; font: 14px system-ui, sans-serif; background: #f4f4f6; color: #222; }
 #view { position: absolute; top: 44px; left: 0; width: 100%; height: calc(100% - 44px); display: block; }
-#bar { height: 44px; display: flex; align-items: center; gap: 12px; padding: 0 10px; background: #fff;
+#bar { height: 44px; display: flex; align-items: center; gap: 8px; padding: 0 8px; font-size: 13px; background: #fff;
        border-bottom: 1px solid #ccc; white-space: nowrap; overflow-x: auto; }
-#slider { flex: 1; min-width: 120px; }
-#frame { font-variant-numeric: tabular-nums; min-width: 9em; }
+#slider { flex: 1; min-width: 80px; }
+#frame { font-variant-numeric: tabular-nums; min-width: 8em; }
 #status { color: #a00; }
 .key { display: inline-block; width: 10px; height: 10px; border-radius: 2px; margin-right: 3px; }
 )";

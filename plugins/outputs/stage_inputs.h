@@ -17,6 +17,7 @@ inline void declare_scene_inputs(StageSpec& s) {
       .input<ArticulatedObject>("object", "the object, canonical frame")
       .input<at::Tensor>("object_states", "[N, 7] object states")
       .input<double>("fps", "frames per second")
+      .optional_input<std::string>("object_path", "the object's folder or YAML (informative)")
       .optional_input<at::Tensor>("contact_maps", "[N, 2, 1024] contact maps that conditioned the motion (m)")
       .optional_input<at::Tensor>("basis_hit_indices", "[N, 1024] int64, with contact_maps")
       .param("mano_left", "", "left hand model .npz (empty: the shipped hand; give both or neither)")
@@ -28,6 +29,7 @@ inline SceneSource scene_from_inputs(StageIO& io, const std::shared_ptr<const st
                                      const std::string& name) {
   SceneSource src;
   src.sequence.name = name;
+  src.sequence.object = io.has("object_path") ? io.in<std::string>("object_path") : "(from the pipeline)";
   src.sequence.fps = io.in<double>("fps");
   src.sequence.object_states = io.in<at::Tensor>("object_states");
   src.sequence.hands = io.in<HandMotion>("hand_params");

@@ -30,8 +30,18 @@ function classify(root) {
   return parts;
 }
 
+// Each vertex's neighbours (from the triangles), so that a contact colours its 1-ring.
+function neighbours(geometry) {
+  const n = geometry.attributes.position.count, idx = geometry.index.array;
+  const ring = Array.from({ length: n }, () => new Set());
+  for (let i = 0; i < idx.length; i += 3)
+    for (let k = 0; k < 3; ++k) { ring[idx[i + k]].add(idx[i + (k + 1) % 3]); ring[idx[i + k]].add(idx[i + (k + 2) % 3]); }
+  return ring.map((r) => Array.from(r));
+}
+
 function prepareContacts(part) {
   if (!part) return;
+  part.userData.ring = neighbours(part.geometry);
   const n = part.geometry.attributes.position.count;
   part.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n).fill(1), 3));
   part.material = part.material.clone();
@@ -90,8 +100,10 @@ async function main() {
       const hits = c.frames[f] || [];
       for (let i = 0; i + 1 < hits.length; i += 2) {
         const v = hits[i], col = CONTACT_COLORS[hits[i + 1]];
-        const attr = v < c.top ? top : bottom, k = v < c.top ? v : v - c.top;
+        const part = v < c.top ? s.parts.top : s.parts.bottom, k = v < c.top ? v : v - c.top;
+        const attr = part.geometry.attributes.color;
         attr.setXYZ(k, col.r, col.g, col.b);
+        for (const q of part.userData.ring[k]) attr.setXYZ(q, col.r, col.g, col.b);
       }
     }
     top.needsUpdate = true; bottom.needsUpdate = true;
@@ -115,17 +127,22 @@ async function main() {
     }
   }
 
+  // Frames the union of the scene's bounds at five moments of the sample.
   function frameCamera() {
     const s = cur();
-    s.mixer.setTime(0);
-    s.root.updateMatrixWorld(true);
-    const box = new THREE.Box3().setFromObject(s.root, true);
+    const box = new THREE.Box3();
+    for (const u of [0, 0.25, 0.5, 0.75, 1]) {
+      s.mixer.setTime(u * (frames() - 1) / fps());
+      s.root.updateMatrixWorld(true);
+      box.union(new THREE.Box3().setFromObject(s.root, true));
+    }
     const centre = box.getCenter(new THREE.Vector3());
     const radius = Math.max(0.05, box.getSize(new THREE.Vector3()).length() / 2);
-    const dist = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+    const dist = 0.8 * radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
     camera.position.copy(centre).add(new THREE.Vector3(0.35, 0.6, 1.0).normalize().multiplyScalar(dist));
     camera.near = dist / 100; camera.far = dist * 10; camera.updateProjectionMatrix();
     controls.target.copy(centre); controls.update();
+    s.mixer.setTime(Math.max(0, frame) / fps());
   }
 
   function selectSample(i) {
