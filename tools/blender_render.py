@@ -60,9 +60,10 @@ scene.collection.objects.link(sun)
 world = bpy.data.worlds.new("world")
 world.use_nodes = True
 world.node_tree.nodes["Background"].inputs[0].default_value = (0.9, 0.9, 0.92, 1)
-world.node_tree.nodes["Background"].inputs[1].default_value = 0.8
+world.node_tree.nodes["Background"].inputs[1].default_value = 0.5
 scene.world = world
 
+scene.view_settings.view_transform = "Standard"
 scene.render.engine = "CYCLES"
 scene.cycles.device = "CPU"
 scene.cycles.samples = 48

@@ -80,7 +80,9 @@ inline Evaluated evaluate(const tinygltf::Model& m, int k) {
 
 // Vertices [V, 3] of the mesh on `node` at keyframe k: skinned when the node has a skin,
 // else moved by the node's world matrix; morph targets applied with the node's weights.
-inline Eigen::MatrixX3d node_vertices(const tinygltf::Model& m, int node, int k, bool morphs = true) {
+// `max_sets` > 0: only the first sets of joints, weights renormalised (as three.js does with
+// its 4 influences).
+inline Eigen::MatrixX3d node_vertices(const tinygltf::Model& m, int node, int k, bool morphs = true, int max_sets = 0) {
   const Evaluated e = evaluate(m, k);
   const auto& prim = m.meshes.at(m.nodes[node].mesh).primitives.at(0);
   const std::vector<float> pos = read_accessor<float>(m, prim.attributes.at("POSITION"));
@@ -105,14 +107,18 @@ inline Eigen::MatrixX3d node_vertices(const tinygltf::Model& m, int node, int k,
   for (size_t j = 0; j < sk.joints.size(); ++j)
     J[j] = e.world[sk.joints[j]] * Eigen::Map<const Eigen::Matrix4f>(ibm.data() + 16 * j).cast<double>();
   out.setZero();
-  for (int set = 0; prim.attributes.count("JOINTS_" + std::to_string(set)); ++set) {
+  Eigen::VectorXd total = Eigen::VectorXd::Zero(V);
+  for (int set = 0; prim.attributes.count("JOINTS_" + std::to_string(set)) && (max_sets <= 0 || set < max_sets); ++set) {
     const auto joints = read_accessor<std::uint8_t>(m, prim.attributes.at("JOINTS_" + std::to_string(set)));
     const auto weights = read_accessor<float>(m, prim.attributes.at("WEIGHTS_" + std::to_string(set)));
     for (size_t v = 0; v < V; ++v)
-      for (int i = 0; i < 4; ++i)
+      for (int i = 0; i < 4; ++i) {
+        total[v] += weights[4 * v + i];
         out.row(v) += weights[4 * v + i] *
                       (J[joints[4 * v + i]] * p.row(v).transpose().homogeneous()).head<3>().transpose();
+      }
   }
+  for (size_t v = 0; v < V; ++v) out.row(v) /= total[v];
   return out;
 }
 
