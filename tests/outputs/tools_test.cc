@@ -50,9 +50,11 @@ bool have_npm_modules() { return fs::exists(fs::path(BIMART_TEST_NPM_DIR) / "nod
 
 // Files every test here uses, made once per process in a scratch folder.
 struct Inputs {
-  fs::path dir = fs::path(BIMART_TEST_WORK_DIR) / ("tools_" + std::to_string(::getpid()));
+  // One folder per suite (each ctest entry runs one, maybe in parallel), replaced each run.
+  fs::path dir = fs::path(BIMART_TEST_WORK_DIR) /
+                 ("tools_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name()));
   std::vector<std::string> ground_truth;  // synthetic ground-truth sequences (shipped hands)
-  fs::path corrective_seq = dir / "corrective" / "seq.npz";
+  fs::path corrective_seq = dir / "corrective" / "seq.npz";  // (members after `dir`)
   fs::path mano_left = dir / "corrective" / "mano_left.npz", mano_right = dir / "corrective" / "mano_right.npz";
   std::array<HandModel, 2> shipped = test::shipped_hand_models();
   std::array<HandModel, 2> corrective{test::with_correctives(shipped[0]), test::with_correctives(shipped[1])};
