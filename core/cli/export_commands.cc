@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "core/cli/command.h"
@@ -49,7 +50,12 @@ int run_export(const ExportOptions& o) {
   // Every scene is built before the first file is written.
   std::vector<std::pair<std::string, std::string>> files;
   std::vector<GltfSummary> sums;
+  std::map<std::string, std::string> written;  // output -> sequence, to refuse two sequences of one stem
   for (const auto& s : sources) {
+    const std::string stem = fs::path(s.path).stem().string();
+    if (auto [it, fresh] = written.emplace(stem, s.path); !fresh)
+      throw Error(fmt::format("bimart export: {} and {} would both be written as {}.glb; export them to different folders",
+                              it->second, s.path, stem));
     GltfSummary sum;
     std::string bytes = build_glb(s.sequence, s.object, s.models(), gltf_options(o), &sum);
     files.emplace_back((fs::path(o.out) / (fs::path(s.path).stem().string() + ".glb")).string(), std::move(bytes));

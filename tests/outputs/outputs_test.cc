@@ -221,6 +221,19 @@ TEST(ExportCommand, WritesOneGlbPerSequence) {
             }()).skins.size(), 2u);
 }
 
+TEST(ExportCommand, RefusesTwoSequencesOfOneName) {
+  fs::create_directories(files().dir / "again");
+  const fs::path twin = files().dir / "again" / "seq.npz";
+  Sequence s = read_sequence(files().seq.string());
+  s.object = "../box";
+  write_sequence(s, twin.string());
+  const fs::path out = files().dir / "out_twins";
+  const auto r = run_bimart("export " + files().seq.string() + " " + twin.string() + " --out " + out.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("would both be written as seq.glb"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(ExportCommand, RefusesATruncatedFile) {
   const fs::path bad = files().dir / "truncated.npz";
   fs::copy_file(files().seq, bad, fs::copy_options::overwrite_existing);
