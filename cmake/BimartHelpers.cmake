@@ -16,7 +16,7 @@ function(bimart_add_plugin name)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${ARG_OUTPUT_DIRECTORY})
   elseif(BIMART_PLUGIN_OUTPUT_DIR)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${BIMART_PLUGIN_OUTPUT_DIR}
-                                               INSTALL_RPATH "$ORIGIN/../..")
+                                               INSTALL_RPATH "$ORIGIN/../..;${BIMART_OPENBLAS_DIR}")
     install(TARGETS ${target} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/bimart/plugins)
     set_property(GLOBAL APPEND PROPERTY BIMART_BUILTIN_PLUGINS ${target})
   endif()

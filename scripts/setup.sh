@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config ccache git
   libtorch-dev libopenblas0-openmp        # networks; OpenMP OpenBLAS (DESIGN §8)
+  libgloo-dev                             # headers of libtorch's distributed (c10d/Gloo) training
   libeigen3-dev libyaml-cpp-dev libcgal-dev libceres-dev
   libfmt-dev libspdlog-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
   libtinygltf-dev libzip-dev libstb-dev             # glTF export; .npz files; PNG pictures

@@ -27,5 +27,7 @@ void add_hand_commands(CLI::App& app, Commands& out);      // hand make
 void add_eval_commands(CLI::App& app, Commands& out);      // eval
 void add_data_commands(CLI::App& app, Commands& out);      // data synth, data stats
 void add_refine_commands(CLI::App& app, Commands& out);    // refine
+void add_train_commands(CLI::App& app, Commands& out);     // train
+void add_generate_commands(CLI::App& app, Commands& out);  // generate
 void add_export_commands(CLI::App& app, Commands& out);    // export, view, render
 }  // namespace bimart::cli

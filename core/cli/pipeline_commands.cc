@@ -123,9 +123,21 @@ int info() {
 int bench_blas(int size, int repeats) {
   const runtime::BlasInfo b = runtime::blas_info();
   std::cout << runtime::describe(b) << "\n";
+  const auto line = [](const char* what, const runtime::MatmulBench& r) {
+    return fmt::format("{0:<18} {1}x{1} float32, {2} repeats: median {3:.4f} s, max {4:.4f} s, {5:.1f} GFLOP/s\n",
+                       what, r.n, r.repeats, r.seconds_median, r.seconds_max, r.gflops_median);
+  };
   const runtime::MatmulBench r = runtime::bench_matmul(size, repeats);
-  std::cout << fmt::format("matmul {0}x{0} float32, {1} repeats: median {2:.4f} s, max {3:.4f} s, {4:.1f} GFLOP/s\n",
-                           r.n, r.repeats, r.seconds_median, r.seconds_max, r.gflops_median);
+  std::cout << line("libtorch matmul", r);
+  if (b.config.empty()) return 0;  // no OpenBLAS to compare with
+  const runtime::MatmulBench direct = runtime::bench_openblas_direct(size, repeats);
+  std::cout << line("OpenBLAS direct", direct);
+  const double ratio = direct.gflops_median > 0 ? r.gflops_median / direct.gflops_median : 0.0;
+  std::cout << fmt::format("libtorch / OpenBLAS direct: {:.0f} %\n", 100.0 * ratio);
+  if (ratio < 0.8) {
+    std::cout << "warning: libtorch reaches less than 80 % of OpenBLAS called directly"
+              << (b.sgemm_in_openblas ? "" : " (its sgemm_ is not OpenBLAS's, see above)") << "\n";
+  }
   return 0;
 }
 

@@ -221,51 +221,61 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
   return st;
 }
 
-void save_normalization(const NormalizationStats& stats, const std::string& path) {
+void store_normalization(const NormalizationStats& stats, NpzFile& f, const std::string& prefix) {
   const std::pair<const at::Tensor*, int64_t> checks[] = {
       {&stats.x_mean, kHandFeatureSize},      {&stats.x_std, kHandFeatureSize}, {&stats.obj_mean, kObjectConditionSize},
       {&stats.obj_std, kObjectConditionSize}, {&stats.c_mean, 2 * kBasisRows},  {&stats.c_std, 2 * kBasisRows}};
   for (const auto& [t, size] : checks)
     if (!t->defined() || t->dim() != 1 || t->size(0) != size)
-      throw Error(path + ": normalisation statistics have a vector of shape " + shape_str(*t) + ", expected [" +
+      throw Error("normalisation statistics have a vector of shape " + shape_str(*t) + ", expected [" +
                   std::to_string(size) + "]");
-  NpzFile f;
-  f.set("format_version", make_npy_scalar<std::int64_t>(kFormatVersion));
-  f.set("variant", make_npy_strings({stats.variant}, {}));
-  f.set("count", make_npy_scalar<std::int64_t>(stats.count));
-  f.set("std_floor", make_npy_scalar<double>(stats.std_floor));
-  f.set("x_mean", npy_of(stats.x_mean));
-  f.set("x_std", npy_of(stats.x_std));
-  f.set("obj_mean", npy_of(stats.obj_mean));
-  f.set("obj_std", npy_of(stats.obj_std));
-  f.set("c_mean", npy_of(stats.c_mean));
-  f.set("c_std", npy_of(stats.c_std));
-  f.write(path);
+  f.set(prefix + "format_version", make_npy_scalar<std::int64_t>(kFormatVersion));
+  f.set(prefix + "variant", make_npy_strings({stats.variant}, {}));
+  f.set(prefix + "count", make_npy_scalar<std::int64_t>(stats.count));
+  f.set(prefix + "std_floor", make_npy_scalar<double>(stats.std_floor));
+  f.set(prefix + "x_mean", npy_of(stats.x_mean));
+  f.set(prefix + "x_std", npy_of(stats.x_std));
+  f.set(prefix + "obj_mean", npy_of(stats.obj_mean));
+  f.set(prefix + "obj_std", npy_of(stats.obj_std));
+  f.set(prefix + "c_mean", npy_of(stats.c_mean));
+  f.set(prefix + "c_std", npy_of(stats.c_std));
 }
 
-NormalizationStats load_normalization(const std::string& path) {
-  const NpzFile f = NpzFile::read(path);
-  if (f.contains("format_version")) {
-    const auto v = f.vector<std::int64_t>("format_version");
+NormalizationStats read_normalization(const NpzFile& f, const std::string& prefix) {
+  const std::string version = prefix + "format_version";
+  if (f.contains(version)) {
+    const auto v = f.vector<std::int64_t>(version);
     if (v.size() != 1 || v[0] > kFormatVersion)
-      throw Error(f.where("format_version") + ": unsupported normalisation file version (this program reads up to " +
+      throw Error(f.where(version) + ": unsupported normalisation file version (this program reads up to " +
                   std::to_string(kFormatVersion) + ")");
   }
   NormalizationStats st;
-  const std::vector<std::string> variant = as_strings(f.get("variant"), f.where("variant"));
-  if (variant.size() != 1) throw Error(f.where("variant") + " must hold one string");
+  const std::vector<std::string> variant = as_strings(f.get(prefix + "variant"), f.where(prefix + "variant"));
+  if (variant.size() != 1) throw Error(f.where(prefix + "variant") + " must hold one string");
   st.variant = variant[0];
-  const auto count = f.vector<std::int64_t>("count");
-  if (count.size() != 1 || count[0] < 1) throw Error(f.where("count") + " must be one positive number");
+  const auto count = f.vector<std::int64_t>(prefix + "count");
+  if (count.size() != 1 || count[0] < 1) throw Error(f.where(prefix + "count") + " must be one positive number");
   st.count = count[0];
-  if (f.contains("std_floor")) st.std_floor = f.vector<double>("std_floor").at(0);
-  st.x_mean = read_vector(f, "x_mean", kHandFeatureSize, false);
-  st.x_std = read_vector(f, "x_std", kHandFeatureSize, true);
-  st.obj_mean = read_vector(f, "obj_mean", kObjectConditionSize, false);
-  st.obj_std = read_vector(f, "obj_std", kObjectConditionSize, true);
-  st.c_mean = read_vector(f, "c_mean", 2 * kBasisRows, false);
-  st.c_std = read_vector(f, "c_std", 2 * kBasisRows, true);
+  if (f.contains(prefix + "std_floor")) st.std_floor = f.vector<double>(prefix + "std_floor").at(0);
+  st.x_mean = read_vector(f, prefix + "x_mean", kHandFeatureSize, false);
+  st.x_std = read_vector(f, prefix + "x_std", kHandFeatureSize, true);
+  st.obj_mean = read_vector(f, prefix + "obj_mean", kObjectConditionSize, false);
+  st.obj_std = read_vector(f, prefix + "obj_std", kObjectConditionSize, true);
+  st.c_mean = read_vector(f, prefix + "c_mean", 2 * kBasisRows, false);
+  st.c_std = read_vector(f, prefix + "c_std", 2 * kBasisRows, true);
   return st;
 }
+
+void save_normalization(const NormalizationStats& stats, const std::string& path) {
+  NpzFile f;
+  try {
+    store_normalization(stats, f, "");
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+  f.write(path);
+}
+
+NormalizationStats load_normalization(const std::string& path) { return read_normalization(NpzFile::read(path), ""); }
 
 }  // namespace bimart

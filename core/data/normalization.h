@@ -22,6 +22,7 @@
 namespace bimart {
 
 class WindowDataset;
+class NpzFile;
 
 constexpr double kNormalizationStdFloor = 1e-3;
 constexpr int kObjectConditionSize = 1024 * 3 + 7;  // [O | G] per frame
@@ -54,6 +55,10 @@ void save_normalization(const NormalizationStats& stats, const std::string& path
 // Throws bimart::Error naming the file and key on a missing key, a wrong shape or a
 // standard deviation that is not positive and finite.
 NormalizationStats load_normalization(const std::string& path);
+
+// The same keys with a prefix, inside another archive (a model checkpoint).
+void store_normalization(const NormalizationStats& stats, NpzFile& file, const std::string& prefix);
+NormalizationStats read_normalization(const NpzFile& file, const std::string& prefix);
 
 // [O flattened | G]: O [..., 1024, 3], G [..., 7] -> [..., 3079].
 at::Tensor object_condition(const at::Tensor& object_features, const at::Tensor& global_states);

@@ -142,6 +142,7 @@ BlasInfo blas_info() {
   }
   if (num_threads != nullptr) info.blas_threads = num_threads();
   info.sgemm_library = library_of(dlsym(RTLD_DEFAULT, "sgemm_"));
+  info.sgemm_in_openblas = config != nullptr && same_openblas(info.sgemm_library, info.library);
   info.chosen_core = choose_openblas_coretype();
 
   info.torch_threads = at::get_num_threads();
@@ -159,6 +160,14 @@ BlasInfo blas_info() {
   return info;
 }
 
+bool same_openblas(const std::string& sgemm_file, const std::string& openblas_file) {
+  if (sgemm_file.empty() || openblas_file.empty()) return false;
+  if (sgemm_file == openblas_file) return true;
+  const auto folder = [](const std::string& f) { return f.substr(0, f.find_last_of('/') + 1); };
+  return folder(sgemm_file) == folder(openblas_file) &&
+         folder(openblas_file).find("openblas") != std::string::npos;
+}
+
 std::string describe(const BlasInfo& info) {
   std::string s;
   if (!info.config.empty()) {
@@ -167,8 +176,13 @@ std::string describe(const BlasInfo& info) {
   } else {
     s += "BLAS:    " + info.library + "\n";
   }
-  if (!info.sgemm_library.empty() && info.sgemm_library != info.library) {
-    s += "sgemm_:  " + info.sgemm_library + "\n";
+  s += "sgemm_:  " + (info.sgemm_library.empty() ? std::string("not found") : info.sgemm_library) +
+       "\n";
+  if (!info.config.empty() && !info.sgemm_in_openblas) {
+    s += "warning: libtorch's matrix products call sgemm_ in " +
+         (info.sgemm_library.empty() ? std::string("no library found") : info.sgemm_library) +
+         ", not in the OpenBLAS reported here (" + info.library +
+         "): they run slower, without its kernel and threads (docs/performance.md, BLAS)\n";
   }
   if (!info.core.empty()) {
     const char* value = env(kCoretypeEnv);
@@ -195,24 +209,21 @@ void set_threads(int n) {
   if (const auto set = find_symbol<SetIntFn>("openblas_set_num_threads")) set(n);
 }
 
-MatmulBench bench_matmul(int n, int repeats) {
+namespace {
+
+// One warm-up call of `product` (thread pool start, page faults, BLAS buffers), then
+// `repeats` timed calls.
+MatmulBench time_matmul(int n, int repeats, const std::function<void()>& product) {
   if (n <= 0) throw Error("matmul benchmark: size must be positive, got " + std::to_string(n));
   if (repeats <= 0) {
     throw Error("matmul benchmark: repeats must be positive, got " + std::to_string(repeats));
   }
-  c10::InferenceMode no_autograd;
-  auto gen = at::detail::createCPUGenerator(/*seed_val=*/12345);
-  const auto opts = at::TensorOptions().dtype(at::kFloat);
-  const at::Tensor a = at::randn({n, n}, gen, opts);
-  const at::Tensor b = at::randn({n, n}, gen, opts);
-  at::Tensor c = at::empty({n, n}, opts);
-
-  at::mm_out(c, a, b);  // warm-up: thread pool start, page faults, BLAS buffers
+  product();
   std::vector<double> seconds;
   seconds.reserve(static_cast<std::size_t>(repeats));
   for (int i = 0; i < repeats; ++i) {
     const auto t0 = std::chrono::steady_clock::now();
-    at::mm_out(c, a, b);
+    product();
     const auto t1 = std::chrono::steady_clock::now();
     seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
   }
@@ -229,6 +240,45 @@ MatmulBench bench_matmul(int n, int repeats) {
   const double flops = 2.0 * static_cast<double>(n) * n * n;
   r.gflops_median = median > 0 ? flops / median / 1e9 : 0.0;
   return r;
+}
+
+struct Operands {
+  at::Tensor a, b, c;
+};
+
+Operands random_operands(int n) {
+  if (n <= 0) throw Error("matmul benchmark: size must be positive, got " + std::to_string(n));
+  auto gen = at::detail::createCPUGenerator(/*seed_val=*/12345);
+  const auto opts = at::TensorOptions().dtype(at::kFloat);
+  return {at::randn({n, n}, gen, opts), at::randn({n, n}, gen, opts), at::empty({n, n}, opts)};
+}
+
+}  // namespace
+
+MatmulBench bench_matmul(int n, int repeats) {
+  c10::InferenceMode no_autograd;
+  Operands m = random_operands(n);
+  return time_matmul(n, repeats, [&] { at::mm_out(m.c, m.a, m.b); });
+}
+
+MatmulBench bench_openblas_direct(int n, int repeats) {
+  // cblas_sgemm(order, transA, transB, M, N, K, alpha, A, lda, B, ldb, beta, C, ldc), taken
+  // from the file that holds openblas_get_config, so it is OpenBLAS's whatever else is loaded.
+  using CblasSgemm = void (*)(int, int, int, int, int, int, float, const float*, int, const float*,
+                              int, float, float*, int);
+  const std::string file = library_of(dlsym(RTLD_DEFAULT, "openblas_get_config"));
+  if (file.empty()) throw Error("no OpenBLAS is loaded in this process: nothing to compare with");
+  void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_NOLOAD);
+  if (handle == nullptr) throw Error("cannot reopen the loaded OpenBLAS " + file);
+  const auto sgemm = reinterpret_cast<CblasSgemm>(dlsym(handle, "cblas_sgemm"));
+  dlclose(handle);  // RTLD_NOLOAD took a reference; the library stays loaded
+  if (sgemm == nullptr) throw Error(file + " has no cblas_sgemm");
+  Operands m = random_operands(n);
+  constexpr int kRowMajor = 101, kNoTrans = 111;
+  return time_matmul(n, repeats, [&] {
+    sgemm(kRowMajor, kNoTrans, kNoTrans, n, n, n, 1.0f, m.a.data_ptr<float>(), n,
+          m.b.data_ptr<float>(), n, 0.0f, m.c.data_ptr<float>(), n);
+  });
 }
 
 }  // namespace bimart::runtime

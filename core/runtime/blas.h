@@ -43,6 +43,9 @@ void ensure_blas_kernel(int argc, char** argv);
 struct BlasInfo {
   std::string library;          // file of the loaded OpenBLAS, or "unknown (not OpenBLAS)"
   std::string sgemm_library;    // file whose sgemm_ the process binds to ("" = none found)
+  // sgemm_ lives in the OpenBLAS of `library` (the wrapper libblas.so.3 of the same
+  // OpenBLAS folder counts): what libtorch's products run on.
+  bool sgemm_in_openblas = false;
   std::string config;           // openblas_get_config(), e.g. "OpenBLAS 0.3.21 ... USE_OPENMP"
   std::string core;             // openblas_get_corename(): the kernel in use
   std::string chosen_core;      // choose_openblas_coretype() on this machine
@@ -55,8 +58,13 @@ struct BlasInfo {
 // Reads the state of this process; never fails (fields it cannot learn are left empty/0).
 BlasInfo blas_info();
 
-// A few lines for `bimart info` / `bimart --version`, each ending in '\n'.
+// A few lines for `bimart info` / `bimart --version`, each ending in '\n'. When sgemm_
+// does not resolve to the OpenBLAS whose kernel is reported, a "warning:" line names both.
 std::string describe(const BlasInfo& info);
+
+// True when `sgemm_file` is OpenBLAS: the same file as `openblas_file`, or a file in the
+// same folder (Debian's libblas.so.3 wrapper of that OpenBLAS). Pure, for tests.
+bool same_openblas(const std::string& sgemm_file, const std::string& openblas_file);
 
 // Sets libtorch's intra-op threads (and so OpenMP's) and OpenBLAS's to n;
 // n <= 0 means all cores (std::thread::hardware_concurrency()).
@@ -73,5 +81,10 @@ struct MatmulBench {
 // Times a float32 n x n matmul through libtorch: one warm-up, then `repeats` timed runs
 // with the current thread settings. Throws bimart::Error if n or repeats is not positive.
 MatmulBench bench_matmul(int n, int repeats);
+
+// The same product through OpenBLAS's own cblas_sgemm (looked up in the loaded OpenBLAS,
+// bypassing whatever sgemm_ libtorch binds to): the reference bench_matmul is compared
+// with. Throws bimart::Error when no OpenBLAS is loaded.
+MatmulBench bench_openblas_direct(int n, int repeats);
 
 }  // namespace bimart::runtime

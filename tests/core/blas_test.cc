@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -382,6 +383,56 @@ TEST(Describe, NamesLibraryKernelAndThreads) {
   EXPECT_EQ(text.back(), '\n');
 }
 
+// DESIGN §8, issue 17: libtorch's products must reach OpenBLAS, whatever else is linked
+// (Debian's Ceres brings ATLAS's libf77blas). Checked with dladdr, without blas_info().
+std::string file_of(const char* symbol) {
+  Dl_info where{};
+  void* p = dlsym(RTLD_DEFAULT, symbol);
+  if (p == nullptr || dladdr(p, &where) == 0 || where.dli_fname == nullptr) return "";
+  char resolved[PATH_MAX];
+  return realpath(where.dli_fname, resolved) != nullptr ? resolved : where.dli_fname;
+}
+
+TEST(BlasInfo, SgemmResolvesToOpenBlas) {
+  const std::string sgemm = file_of("sgemm_");
+  const std::string openblas = file_of("openblas_get_config");
+  ASSERT_FALSE(openblas.empty()) << "OpenBLAS is not loaded in this process";
+  ASSERT_FALSE(sgemm.empty()) << "no sgemm_ in this process";
+  EXPECT_NE(lower(sgemm).find("openblas"), std::string::npos)
+      << "sgemm_ resolves to " << sgemm << ", not to OpenBLAS (" << openblas << ")";
+  const BlasInfo info = blas_info();
+  EXPECT_EQ(info.sgemm_library, sgemm);
+  EXPECT_TRUE(info.sgemm_in_openblas);
+  EXPECT_EQ(describe(info).find("warning:"), std::string::npos) << describe(info);
+}
+
+TEST(SameOpenblas, SameFileOrItsWrapper) {
+  const std::string dir = "/usr/lib/x86_64-linux-gnu/openblas-openmp/";
+  EXPECT_TRUE(same_openblas(dir + "libopenblasp-r0.3.21.so", dir + "libopenblasp-r0.3.21.so"));
+  EXPECT_TRUE(same_openblas(dir + "libblas.so.3", dir + "libopenblasp-r0.3.21.so"));
+  EXPECT_FALSE(same_openblas("/usr/lib/x86_64-linux-gnu/libf77blas.so.3", dir + "libopenblasp-r0.3.21.so"));
+  EXPECT_FALSE(same_openblas("", dir + "libopenblasp-r0.3.21.so"));
+  EXPECT_FALSE(same_openblas("/usr/lib/libblas.so.3", "/usr/lib/libother.so"));  // folder not OpenBLAS's
+}
+
+TEST(Describe, WarnsWhenSgemmIsNotTheReportedOpenBlas) {
+  BlasInfo info;
+  info.library = "/usr/lib/x86_64-linux-gnu/openblas-openmp/libopenblasp-r0.3.21.so";
+  info.config = "OpenBLAS 0.3.21 USE_OPENMP";
+  info.core = "SkylakeX";
+  info.sgemm_library = "/usr/lib/x86_64-linux-gnu/libf77blas.so.3";
+  info.sgemm_in_openblas = false;
+  const std::string text = describe(info);
+  const auto warning = text.find("warning:");
+  ASSERT_NE(warning, std::string::npos) << text;
+  const std::string line = text.substr(warning, text.find('\n', warning) - warning);
+  EXPECT_NE(line.find(info.sgemm_library), std::string::npos) << line;
+  EXPECT_NE(line.find(info.library), std::string::npos) << line;
+  info.sgemm_library = info.library;
+  info.sgemm_in_openblas = true;
+  EXPECT_EQ(describe(info).find("warning:"), std::string::npos);
+}
+
 // ---- bench_matmul ----
 
 TEST(BenchMatmul, NumbersAreConsistent) {
@@ -396,6 +447,14 @@ TEST(BenchMatmul, NumbersAreConsistent) {
   EXPECT_GT(b.gflops_median, 0.0);
   const double expected = 2.0 * 64 * 64 * 64 / b.seconds_median / 1e9;
   EXPECT_NEAR(b.gflops_median, expected, 1e-9 * expected);
+}
+
+TEST(BenchMatmul, DirectOpenBlasComputesTheSameProductRate) {
+  if (!openblas_loaded()) GTEST_SKIP() << "OpenBLAS is not loaded";
+  const MatmulBench d = bench_openblas_direct(64, 3);
+  EXPECT_EQ(d.n, 64);
+  EXPECT_GT(d.gflops_median, 0.0);
+  EXPECT_THROW(bench_openblas_direct(0, 3), Error);
 }
 
 TEST(BenchMatmul, RejectsNonPositiveArguments) {

@@ -3,7 +3,10 @@
 // naming it, and registers nothing.
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include "core/pipeline/plugin_loader.h"
+#include "core/runtime/blas.h"
 
 using namespace bimart;
 
@@ -113,4 +116,24 @@ TEST(PluginLoader, RefusesTheSameKeyTwiceInOneLibrary) {
 TEST(PluginLoader, MissingFile) {
   Registry r;
   EXPECT_HAS(refusal("/nonexistent/libx.so", r), "/nonexistent/libx.so does not exist");
+}
+
+// DESIGN §8: a plug-in that links Ceres (ATLAS on Debian) must still reach OpenBLAS when it
+// calls sgemm_, as libtorch inside it does: plug-ins share the host's load order.
+TEST(PluginLoader, SgemmInsideAPluginIsOpenBlas) {
+  Registry r;
+  PluginLoader loader(r);
+  const std::string lib = test_lib("test_blas_probe");
+  loader.load(lib);
+  void* handle = dlopen(lib.c_str(), RTLD_NOW | RTLD_NOLOAD);
+  ASSERT_NE(handle, nullptr) << lib << " is not loaded";
+  using Probe = const char* (*)();
+  const auto probe = reinterpret_cast<Probe>(dlsym(handle, "bimart_test_sgemm_library"));
+  ASSERT_NE(probe, nullptr);
+  const std::string bound = probe();
+  dlclose(handle);
+  const runtime::BlasInfo info = runtime::blas_info();
+  ASSERT_FALSE(info.config.empty()) << "OpenBLAS is not loaded in the test process";
+  EXPECT_TRUE(runtime::same_openblas(bound, info.library))
+      << "the plug-in's sgemm_ is bound to " << bound << ", not to OpenBLAS (" << info.library << ")";
 }

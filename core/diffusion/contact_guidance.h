@@ -1,0 +1,44 @@
+// Contact-map guidance (DESIGN §5, paper eq. 5-6): from the predicted clean keypoints H,
+// the contact map they imply — for each of the 1024 object points of a frame, the distance
+// to the nearest of the hand's J keypoints — is compared with the target map C; the
+// correction is minus the gradient of the mean squared difference with respect to H,
+// scaled to norm `scale` per sample (λ_c = 1 / ||∇||). D is moved by the opposite of H's
+// correction, so H + D (the surface point each keypoint refers to) stays put.
+//
+// The gradient is analytic (only the nearest keypoint of each object point carries it),
+// not autograd: nearest keypoints by one batched matrix product per hand.
+#pragma once
+
+#include <cstdint>
+
+#include <ATen/core/Tensor.h>
+
+#include "stages/guidance.h"
+
+namespace bimart::diffusion {
+
+class ContactMapGuidance : public Guidance {
+ public:
+  // object_points [N, 1024, 3] (canonical frame, articulated: basis_hit_points), target
+  // contact maps [N, 2, 1024] or [S, N, 2, 1024] (m). scale: norm of the correction per
+  // sample; 0 turns guidance off.
+  ContactMapGuidance(at::Tensor object_points, at::Tensor target, double scale = 1.0);
+
+  at::Tensor correction(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
+
+  // The contact map implied by keypoints H [B, T, 2, J, 3] for object points [T, 1024, 3]:
+  // [B, T, 2, 1024], and the index of the nearest keypoint [B, T, 2, 1024].
+  static std::pair<at::Tensor, at::Tensor> keypoint_contact_map(const at::Tensor& keypoints,
+                                                                const at::Tensor& object_points);
+  // Mean squared difference between the map implied by x0's keypoints and the target, per
+  // sample [B] (for tests and logs).
+  at::Tensor discrepancy(const at::Tensor& x0, std::int64_t first_frame) const;
+
+ private:
+  at::Tensor targets(std::int64_t first, std::int64_t T, std::int64_t B) const;
+  at::Tensor points_;  // [N, 1024, 3] float32
+  at::Tensor target_;  // [S, N, 2, 1024] float32
+  double scale_;
+};
+
+}  // namespace bimart::diffusion

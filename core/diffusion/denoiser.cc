@@ -1,0 +1,148 @@
+#include "core/diffusion/denoiser.h"
+
+#include <torch/nn/modules/activation.h>
+#include <torch/nn/modules/transformerlayer.h>
+
+#include <cmath>
+
+#include "core/util/error.h"
+
+namespace bimart::diffusion {
+namespace {
+
+torch::nn::Sequential condition_mlp(int in, int hidden, int out) {
+  return torch::nn::Sequential(torch::nn::Linear(in, hidden), torch::nn::ReLU(),
+                               torch::nn::Linear(hidden, hidden), torch::nn::ReLU(),
+                               torch::nn::Linear(hidden, out));
+}
+
+void require(bool ok, const std::string& field, const std::string& what) {
+  if (!ok) throw Error("denoiser config: '" + field + "' " + what);
+}
+
+}  // namespace
+
+DenoiserConfig DenoiserConfig::paper(const std::string& model) {
+  DenoiserConfig c;
+  c.model = model;
+  if (model == "contact") {
+    c.sample_size = 2048;
+    c.contact_condition_size = 0;
+  } else {
+    c.sample_size = 1200;
+    c.contact_condition_size = 2048;
+  }
+  return c;
+}
+
+void DenoiserConfig::validate() const {
+  require(model == "contact" || model == "motion", "model", "must be contact or motion, got '" + model + "'");
+  require(sample_size > 0, "sample_size", "must be positive");
+  require(object_condition_size > 0, "object_condition_size", "must be positive");
+  require(contact_condition_size >= 0, "contact_condition_size", "must not be negative");
+  require(model != "motion" || contact_condition_size > 0, "contact_condition_size",
+          "must be positive for the motion model");
+  require(window >= 1 && window <= 4096, "window", "must be in [1, 4096], got " + std::to_string(window));
+  require(latent >= 8 && latent <= 8192, "latent", "must be in [8, 8192], got " + std::to_string(latent));
+  require(heads >= 1 && latent % heads == 0, "heads",
+          "must divide latent (" + std::to_string(latent) + "), got " + std::to_string(heads));
+  require(layers >= 1 && layers <= 64, "layers", "must be in [1, 64], got " + std::to_string(layers));
+  require(feedforward >= 1, "feedforward", "must be positive");
+  require(condition_hidden >= 1, "condition_hidden", "must be positive");
+  require(dropout >= 0 && dropout < 1, "dropout", "must be in [0, 1)");
+}
+
+std::string DenoiserConfig::describe() const {
+  return model + " denoiser: latent " + std::to_string(latent) + ", " + std::to_string(layers) +
+         " layers, " + std::to_string(heads) + " heads, feed-forward " + std::to_string(feedforward) +
+         ", condition MLPs " + std::to_string(condition_hidden) + ", window " + std::to_string(window);
+}
+
+at::Tensor timestep_embedding(const at::Tensor& t, int dim) {
+  const int half = dim / 2;
+  const auto freqs =
+      torch::exp(-std::log(10000.0) * torch::arange(half, torch::kFloat) / static_cast<double>(half));
+  const auto args = t.to(torch::kFloat).unsqueeze(1) * freqs.unsqueeze(0);
+  auto emb = torch::cat({torch::sin(args), torch::cos(args)}, 1);
+  if (dim % 2 == 1) emb = torch::cat({emb, torch::zeros({t.size(0), 1})}, 1);
+  return emb;
+}
+
+at::Tensor sinusoidal_positions(int count, int dim) {
+  return timestep_embedding(torch::arange(count, torch::kLong), dim);
+}
+
+DenoiserImpl::DenoiserImpl(const DenoiserConfig& config) : config_(config) {
+  config_.validate();
+  const int L = config_.latent;
+  input_ = register_module("input", torch::nn::Linear(config_.sample_size, L));
+  output_ = register_module("output", torch::nn::Linear(L, config_.sample_size));
+  time_mlp_ = register_module(
+      "time_mlp", torch::nn::Sequential(torch::nn::Linear(L, L), torch::nn::SiLU(), torch::nn::Linear(L, L)));
+  object_mlp_ = register_module("object_mlp", condition_mlp(config_.object_condition_size,
+                                                            config_.condition_hidden, L));
+  if (config_.contact_condition_size > 0) {
+    contact_mlp_ = register_module("contact_mlp", condition_mlp(config_.contact_condition_size,
+                                                                config_.condition_hidden, L));
+    null_contact_ = register_parameter("null_contact", torch::randn({config_.window, L}) * 0.02);
+  }
+  auto layer = torch::nn::TransformerEncoderLayerOptions(L, config_.heads)
+                   .dim_feedforward(config_.feedforward)
+                   .dropout(config_.dropout)
+                   .activation(torch::kGELU);
+  encoder_ = register_module(
+      "encoder", torch::nn::TransformerEncoder(torch::nn::TransformerEncoderOptions(layer, config_.layers)));
+  positions_ = register_buffer("positions", sinusoidal_positions(config_.window + 1, L));
+}
+
+at::Tensor DenoiserImpl::encode_conditions(const at::Tensor& object, const at::Tensor& contact,
+                                           const at::Tensor& use_contact) {
+  const auto B = object.size(0), T = object.size(1);
+  if (object.dim() != 3 || object.size(2) != config_.object_condition_size) {
+    throw Error("denoiser: object condition must be [B, T, " +
+                std::to_string(config_.object_condition_size) + "], got " + c10::str(object.sizes()));
+  }
+  if (T > config_.window) {
+    throw Error("denoiser: " + std::to_string(T) + " frames exceed the model's window of " +
+                std::to_string(config_.window));
+  }
+  at::Tensor cond = object_mlp_->forward(object);
+  if (config_.contact_condition_size == 0) return cond;
+  const at::Tensor null = null_contact_.slice(0, 0, T).unsqueeze(0).expand({B, T, config_.latent});
+  if (!contact.defined()) return cond + null;
+  if (contact.dim() != 3 || contact.size(0) != B || contact.size(1) != T ||
+      contact.size(2) != config_.contact_condition_size) {
+    throw Error("denoiser: contact condition must be [" + std::to_string(B) + ", " + std::to_string(T) +
+                ", " + std::to_string(config_.contact_condition_size) + "], got " + c10::str(contact.sizes()));
+  }
+  const at::Tensor c = contact_mlp_->forward(contact);
+  if (!use_contact.defined()) return cond + c;
+  const at::Tensor keep = use_contact.to(torch::kBool).view({B, 1, 1});
+  return cond + torch::where(keep, c, null);
+}
+
+at::Tensor DenoiserImpl::forward(const at::Tensor& x_t, const at::Tensor& t, const at::Tensor& cond) {
+  const auto B = x_t.size(0), T = x_t.size(1);
+  if (x_t.dim() != 3 || x_t.size(2) != config_.sample_size) {
+    throw Error("denoiser: sample must be [B, T, " + std::to_string(config_.sample_size) + "], got " +
+                c10::str(x_t.sizes()));
+  }
+  if (cond.size(0) != B || cond.size(1) != T) {
+    throw Error("denoiser: conditions " + c10::str(cond.sizes()) + " do not match the sample " +
+                c10::str(x_t.sizes()));
+  }
+  const at::Tensor frames = input_->forward(x_t) + cond;                         // [B, T, L]
+  const at::Tensor step = time_mlp_->forward(timestep_embedding(t, config_.latent)).unsqueeze(1);
+  const at::Tensor tokens = torch::cat({step, frames}, 1) + positions_.slice(0, 0, T + 1).unsqueeze(0);
+  // libtorch's encoder takes [sequence, batch, latent].
+  const at::Tensor encoded = encoder_->forward(tokens.transpose(0, 1)).transpose(0, 1);
+  return output_->forward(encoded.slice(1, 1, T + 1));
+}
+
+std::int64_t DenoiserImpl::num_parameters() const {
+  std::int64_t n = 0;
+  for (const auto& p : parameters()) n += p.numel();
+  return n;
+}
+
+}  // namespace bimart::diffusion

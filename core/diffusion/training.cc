@@ -1,0 +1,580 @@
+#include "core/diffusion/training.h"
+
+#include <torch/nn/utils/clip_grad.h>
+#include <torch/optim/adam.h>
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "core/data/manifest.h"
+#include "core/data/normalization.h"
+#include "core/data/window_dataset.h"
+#include "core/diffusion/checkpoint.h"
+#include "core/diffusion/distributed.h"
+#include "core/diffusion/schedule.h"
+#include "core/hand/hand_model.h"
+#include "core/metrics/hand_vertices.h"
+#include "core/util/atomic_file.h"
+#include "core/util/error.h"
+#include "core/util/log.h"
+#include "core/util/progress.h"
+
+namespace fs = std::filesystem;
+
+namespace bimart::diffusion {
+namespace {
+
+// ---- configuration ----
+
+std::string where(const std::string& file, const YAML::Node& n) {
+  return file + ":" + std::to_string(n.Mark().line + 1);
+}
+
+void check_keys(const std::string& file, const YAML::Node& map, const std::string& section,
+                const std::set<std::string>& known) {
+  if (!map.IsMap()) throw Error(where(file, map) + ": '" + section + "' must be a mapping");
+  for (const auto& kv : map) {
+    const std::string key = kv.first.as<std::string>();
+    if (known.count(key)) continue;
+    std::string list;
+    for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+    throw Error(where(file, kv.first) + ": unknown key '" + key + "' in " + section + " (known: " + list + ")");
+  }
+}
+
+template <class T>
+void read(const std::string& file, const YAML::Node& map, const char* key, T& out) {
+  const YAML::Node n = map[key];
+  if (!n) return;
+  try {
+    out = n.as<T>();
+  } catch (const YAML::Exception&) {
+    throw Error(where(file, n) + ": '" + key + "' has a value of the wrong type");
+  }
+}
+
+void set_sizes(DenoiserConfig& n, const std::string& model) {
+  n.model = model;
+  n.sample_size = model == "contact" ? 2 * kBasisRows : 1200;
+  n.object_condition_size = kObjectConditionSize;
+  n.contact_condition_size = model == "contact" ? 0 : 2 * kBasisRows;
+}
+
+// ---- helpers ----
+
+std::uint64_t mix(std::uint64_t a, std::uint64_t b) {  // splitmix64 of a combined word
+  std::uint64_t z = a + 0x9e3779b97f4a7c15ULL * (b + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+// Every random draw of a step comes from a seed of (config seed, step, rank): an
+// interrupted run resumes with identical batches, noise and dropout, and no random state
+// needs storing.
+void seed_step(std::uint64_t seed, std::int64_t step, int rank, std::mt19937_64& data_rng) {
+  const std::uint64_t s = mix(mix(seed, static_cast<std::uint64_t>(step)), static_cast<std::uint64_t>(rank));
+  data_rng.seed(s);
+  auto gen = at::detail::getDefaultCPUGenerator();
+  std::lock_guard<std::mutex> lock(gen.mutex());
+  gen.set_current_seed(mix(s, 17));
+}
+
+std::string fmt_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = static_cast<long>(seconds + 0.5);
+  if (s >= 3600) return std::to_string(s / 3600) + "h" + (s % 3600 / 60 < 10 ? "0" : "") + std::to_string(s % 3600 / 60) + "m";
+  if (s >= 60) return std::to_string(s / 60) + "m" + (s % 60 < 10 ? "0" : "") + std::to_string(s % 60) + "s";
+  return std::to_string(s) + "s";
+}
+
+std::string adam_key(const at::Tensor& p) { return c10::guts::to_string(p.unsafeGetTensorImpl()); }
+
+// torch::optim::Adam keeps its per-parameter state under the address of the parameter's
+// TensorImpl (torch/csrc/api/src/optim/adam.cpp); these two move it to and from names.
+void save_adam(torch::optim::Adam& opt, torch::nn::Module& net, TrainState& st) {
+  for (const auto& p : net.named_parameters()) {
+    auto it = opt.state().find(adam_key(p.value()));
+    if (it == opt.state().end()) continue;
+    const auto& s = static_cast<const torch::optim::AdamParamState&>(*it->second);
+    st.adam_exp_avg[p.key()] = s.exp_avg().detach().clone();
+    st.adam_exp_avg_sq[p.key()] = s.exp_avg_sq().detach().clone();
+    st.adam_step = s.step();
+  }
+}
+
+void restore_adam(torch::optim::Adam& opt, torch::nn::Module& net, const TrainState& st, const std::string& what) {
+  for (const auto& p : net.named_parameters()) {
+    const auto m = st.adam_exp_avg.find(p.key());
+    const auto v = st.adam_exp_avg_sq.find(p.key());
+    if (m == st.adam_exp_avg.end() || v == st.adam_exp_avg_sq.end()) {
+      if (st.adam_step == 0) continue;
+      throw Error(what + ": no optimizer state for '" + p.key() + "'");
+    }
+    if (!m->second.sizes().equals(p.value().sizes()) || !v->second.sizes().equals(p.value().sizes()))
+      throw Error(what + ": optimizer state for '" + p.key() + "' has the wrong shape");
+    auto s = std::make_unique<torch::optim::AdamParamState>();
+    s->step(st.adam_step);
+    s->exp_avg(m->second.clone());
+    s->exp_avg_sq(v->second.clone());
+    opt.state()[adam_key(p.value())] = std::move(s);
+  }
+}
+
+struct LossRow {
+  std::int64_t step;
+  double lr, loss, validation, windows_per_second, seconds;
+};
+
+std::vector<LossRow> read_loss_log(const std::string& path, std::int64_t up_to_step) {
+  std::vector<LossRow> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    LossRow r{};
+    char c;
+    std::string val;
+    if (!(s >> r.step >> c >> r.lr >> c >> r.loss >> c)) continue;
+    std::getline(s, val, ',');
+    r.validation = val.empty() ? NAN : std::stod(val);
+    s >> r.windows_per_second >> c >> r.seconds;
+    if (r.step <= up_to_step) rows.push_back(r);
+  }
+  return rows;
+}
+
+void write_loss_log(const std::string& path, const std::vector<LossRow>& rows) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "step,lr,loss,validation,windows_per_second,seconds\n";
+    char buf[256];
+    for (const auto& r : rows) {
+      std::string v;
+      if (std::isfinite(r.validation)) {
+        std::snprintf(buf, sizeof buf, "%.6f", r.validation);
+        v = buf;
+      }
+      std::snprintf(buf, sizeof buf, "%lld,%.6g,%.6f,%s,%.2f,%.1f\n", static_cast<long long>(r.step), r.lr, r.loss,
+                    v.c_str(), r.windows_per_second, r.seconds);
+      out << buf;
+    }
+  });
+}
+
+std::vector<std::int64_t> hand_keypoint_ids() {
+  const auto files = posing_hand_model_files();
+  const HandModel left = load_hand_model(files[0]);
+  return std::vector<std::int64_t>(left.keypoints.begin(), left.keypoints.end());
+}
+
+}  // namespace
+
+// ---- configuration ----
+
+TrainConfig load_train_config(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw Error("cannot read the training config " + path);
+  } catch (const YAML::Exception& e) {
+    throw Error(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  TrainConfig c;
+  c.file = path;
+  {
+    std::ifstream in(path);
+    std::ostringstream s;
+    s << in.rdbuf();
+    c.text = s.str();
+  }
+  check_keys(path, root, "the training config",
+             {"model", "data", "out", "export", "variant", "stride", "network", "diffusion", "training"});
+  read(path, root, "model", c.model);
+  if (c.model != "contact" && c.model != "motion")
+    throw Error(where(path, root["model"] ? root["model"] : root) + ": 'model' must be contact or motion");
+  c.network = DenoiserConfig::paper(c.model);
+  read(path, root, "data", c.data);
+  read(path, root, "out", c.out);
+  read(path, root, "export", c.export_path);
+  read(path, root, "variant", c.variant);
+  read(path, root, "stride", c.stride);
+  if (const YAML::Node n = root["network"]) {
+    check_keys(path, n, "network", {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout"});
+    read(path, n, "latent", c.network.latent);
+    read(path, n, "layers", c.network.layers);
+    read(path, n, "heads", c.network.heads);
+    read(path, n, "feedforward", c.network.feedforward);
+    read(path, n, "condition_hidden", c.network.condition_hidden);
+    read(path, n, "dropout", c.network.dropout);
+  }
+  if (const YAML::Node n = root["diffusion"]) {
+    check_keys(path, n, "diffusion", {"schedule", "steps"});
+    read(path, n, "schedule", c.schedule);
+    read(path, n, "steps", c.diffusion_steps);
+  }
+  if (const YAML::Node n = root["training"]) {
+    check_keys(path, n, "training",
+               {"batch", "steps", "lr", "warmup", "weight_decay", "grad_clip", "ema", "contact_dropout", "seed",
+                "checkpoint_every", "validate_every", "validation_windows", "log_every"});
+    read(path, n, "batch", c.batch);
+    read(path, n, "steps", c.steps);
+    read(path, n, "lr", c.lr);
+    read(path, n, "warmup", c.warmup);
+    read(path, n, "weight_decay", c.weight_decay);
+    read(path, n, "grad_clip", c.grad_clip);
+    read(path, n, "ema", c.ema);
+    read(path, n, "contact_dropout", c.contact_dropout);
+    read(path, n, "seed", c.seed);
+    read(path, n, "checkpoint_every", c.checkpoint_every);
+    read(path, n, "validate_every", c.validate_every);
+    read(path, n, "validation_windows", c.validation_windows);
+    read(path, n, "log_every", c.log_every);
+  }
+  set_sizes(c.network, c.model);
+  try {
+    validate(c);
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+  return c;
+}
+
+void validate(const TrainConfig& c) {
+  const auto need = [](bool ok, const std::string& msg) {
+    if (!ok) throw Error(msg);
+  };
+  need(c.model == "contact" || c.model == "motion", "'model' must be contact or motion");
+  need(!c.data.empty(), "'data' (the data set folder) is required");
+  need(!c.out.empty(), "'out' (the run folder) is required");
+  parse_bps_variant(c.variant);
+  need(c.stride >= 1, "'stride' must be positive");
+  c.network.validate();
+  make_schedule(c.schedule, c.diffusion_steps);
+  need(c.batch >= 1 && c.batch <= 100000, "'training.batch' must be in [1, 100000]");
+  need(c.steps >= 1, "'training.steps' must be positive");
+  need(c.lr > 0 && c.lr < 1, "'training.lr' must be in (0, 1)");
+  need(c.warmup >= 0, "'training.warmup' must not be negative");
+  need(c.weight_decay >= 0, "'training.weight_decay' must not be negative");
+  need(c.grad_clip >= 0, "'training.grad_clip' must not be negative");
+  need(c.ema >= 0 && c.ema < 1, "'training.ema' must be in [0, 1)");
+  need(c.contact_dropout >= 0 && c.contact_dropout <= 1, "'training.contact_dropout' must be in [0, 1]");
+  need(c.checkpoint_every >= 1, "'training.checkpoint_every' must be positive");
+  need(c.validate_every >= 0, "'training.validate_every' must not be negative");
+  need(c.validation_windows >= 1, "'training.validation_windows' must be positive");
+  need(c.log_every >= 1, "'training.log_every' must be positive");
+}
+
+double learning_rate(const TrainConfig& c, std::int64_t step) {
+  if (c.warmup > 0 && step < c.warmup) return c.lr * static_cast<double>(step + 1) / c.warmup;
+  const double span = std::max<double>(1.0, static_cast<double>(c.steps - c.warmup));
+  const double progress = std::min(1.0, static_cast<double>(step - c.warmup) / span);
+  return c.lr * 0.5 * (1.0 + std::cos(M_PI * progress));
+}
+
+// ---- one step ----
+
+StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b) {
+  StepInputs in;
+  const auto B = b.hand_features.size(0);
+  in.object = stats.normalize_object(b.object_features, b.global_states);
+  if (c.model == "contact") {
+    in.sample = stats.normalize_c(b.contact_maps).flatten(-2);
+  } else {
+    in.sample = stats.normalize_x(b.hand_features);
+    in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
+    in.use_contact = at::rand({B}) >= c.contact_dropout;
+  }
+  in.mask = b.mask;
+  in.noise = at::randn(in.sample.sizes());
+  in.t = at::randint(0, c.diffusion_steps, {B}, at::kLong);
+  return in;
+}
+
+LossParts step_loss(Denoiser& net, const NoiseSchedule& schedule, const StepInputs& in) {
+  const at::Tensor x_t = add_noise(schedule, in.sample, in.noise, in.t);
+  const at::Tensor cond = net->encode_conditions(in.object, in.contact, in.use_contact);
+  const at::Tensor pred = net->forward(x_t, in.t, cond);
+  const at::Tensor err = (pred - in.sample).pow(2).mean(-1);  // [B, T]
+  LossParts lp;
+  lp.sum = (err * in.mask).sum();
+  lp.frames = in.mask.sum().item<double>();
+  return lp;
+}
+
+StepInputs draw_step(const TrainConfig& config, const NormalizationStats& stats, const WindowDataset& data,
+                     std::int64_t step, int rank) {
+  std::mt19937_64 rng;
+  seed_step(config.seed, step, rank, rng);
+  return make_step_inputs(config, stats, data.sample_batch(config.batch, rng));
+}
+
+std::string data_fingerprint(const std::string& folder) {
+  std::uint64_t h = 1469598103934665603ULL;
+  const auto feed = [&](const std::string& s) {
+    for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ULL;
+  };
+  const fs::path manifest = fs::path(folder) / "manifest.json";
+  std::ifstream in(manifest, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  feed(text.str());
+  const DatasetManifest m = read_manifest(folder);
+  for (const auto& f : split_files(m, folder, "train")) {
+    std::error_code ec;
+    feed(f);
+    feed(std::to_string(fs::file_size(f, ec)));
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+// ---- the loop ----
+
+TrainResult train(const TrainConfig& config, const TrainOptions& options) {
+  validate(config);
+  DataParallel* dp = options.parallel.get();
+  const int rank = dp ? dp->rank() : 0;
+  const int world = dp ? dp->world_size() : 1;
+  const bool root = rank == 0;
+  const bool show = options.progress && root;
+  const auto t_start = std::chrono::steady_clock::now();
+
+  const fs::path out(config.out);
+  const std::string checkpoint_path = (out / "checkpoint.npz").string();
+  const std::string log_path = (out / "loss.csv").string();
+  if (root) {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw Error("cannot create the run folder " + config.out + ": " + ec.message());
+  }
+
+  // Data.
+  WindowDatasetOptions wo;
+  wo.variant = parse_bps_variant(config.variant);
+  wo.stride = config.stride;
+  std::unique_ptr<ProgressBar> bar;
+  wo.progress = [&](std::size_t done, std::size_t total) {
+    if (!bar) bar = std::make_unique<ProgressBar>("features", total, show);
+    bar->step();
+    (void)done;
+  };
+  const WindowDataset train_set = WindowDataset::open(config.data, "train", wo);
+  bar.reset();
+  std::unique_ptr<WindowDataset> test_set;
+  if (config.validate_every > 0 && root)
+    test_set = std::make_unique<WindowDataset>(WindowDataset::open(config.data, "test", wo));
+  bar.reset();
+  if (train_set.size() == 0) throw Error(config.data + ": the train split has no windows");
+  const NormalizationStats stats = compute_normalization(train_set);
+  const NoiseSchedule schedule = make_schedule(config.schedule, config.diffusion_steps);
+
+  ModelInfo info;
+  info.network = config.network;
+  info.schedule = config.schedule;
+  info.diffusion_steps = config.diffusion_steps;
+  info.variant = config.variant;
+  info.basis_points = train_set.basis_points();
+  info.keypoints = hand_keypoint_ids();
+  info.normalization = stats;
+  info.config_text = config.text;
+  info.data_fingerprint = data_fingerprint(config.data);
+
+  // Networks: the trained one and its EMA copy (used for validation and sampling).
+  torch::manual_seed(config.seed);
+  Denoiser net(config.network);
+  Denoiser ema_net(config.network);
+  load_state(*ema_net, state_of(*net), "EMA copy");
+  ema_net->eval();
+  torch::optim::Adam opt(net->parameters(), torch::optim::AdamOptions(config.lr).weight_decay(config.weight_decay));
+
+  std::int64_t step = 0;
+  double best_validation = NAN;
+  std::vector<LossRow> rows;
+  if (options.resume) {
+    if (!fs::exists(checkpoint_path))
+      throw Error("--resume: no checkpoint " + checkpoint_path + " to resume from");
+    const Checkpoint ck = load_checkpoint(checkpoint_path);
+    if (!ck.train) throw Error(checkpoint_path + " holds no training state (an exported model?)");
+    check_compatible(ck.info, checkpoint_path, config.model, config.variant, info.basis_points, info.keypoints);
+    if (ck.info.network.describe() != config.network.describe())
+      throw Error(checkpoint_path + ": the network differs from the config (" + ck.info.network.describe() +
+                  " vs " + config.network.describe() + ")");
+    if (ck.info.data_fingerprint != info.data_fingerprint)
+      log::warn("{}: the training data changed since this run started (fingerprint {} vs {})", checkpoint_path,
+                ck.info.data_fingerprint, info.data_fingerprint);
+    load_state(*net, ck.train->weights, checkpoint_path);
+    load_state(*ema_net, ck.weights, checkpoint_path);
+    restore_adam(opt, *net, *ck.train, checkpoint_path);
+    step = ck.train->step;
+    best_validation = ck.train->best_validation;
+    if (root) rows = read_loss_log(log_path, step);
+    if (show) log::info("resuming {} at step {} of {}", checkpoint_path, step, config.steps);
+  }
+  if (dp) {
+    // Same start on every process, whatever each one read.
+    std::vector<at::Tensor> all;
+    for (auto& p : net->parameters()) all.push_back(p);
+    for (auto& p : ema_net->parameters()) all.push_back(p);
+    torch::NoGradGuard ng;
+    dp->broadcast(all);
+  }
+  if (show)
+    log::info("training {} ({} parameters) on {} windows of {} ({} processes), batch {}", config.network.describe(),
+              net->num_parameters(), train_set.size(), config.data, world, config.batch);
+
+  const auto write_checkpoint = [&]() {
+    Checkpoint ck;
+    ck.info = info;
+    ck.weights = state_of(*ema_net);
+    TrainState st;
+    st.step = step;
+    st.weights = state_of(*net);
+    save_adam(opt, *net, st);
+    st.best_validation = best_validation;
+    ck.train = std::move(st);
+    save_checkpoint(ck, checkpoint_path);
+    if (!config.export_path.empty()) {
+      Checkpoint release;
+      release.info = info;
+      release.weights = ck.weights;
+      save_checkpoint(release, config.export_path);
+    }
+    write_loss_log(log_path, rows);
+  };
+
+  const auto validation_loss = [&]() {
+    torch::NoGradGuard ng;
+    const std::int64_t n = std::min<std::int64_t>(config.validation_windows, static_cast<std::int64_t>(test_set->size()));
+    double sum = 0, frames = 0;
+    constexpr std::int64_t kChunk = 32;
+    for (std::int64_t first = 0, chunk = 0; first < n; first += kChunk, ++chunk) {
+      std::vector<std::int64_t> idx;
+      for (std::int64_t i = first; i < std::min(n, first + kChunk); ++i)
+        idx.push_back(i * static_cast<std::int64_t>(test_set->size()) / n);
+      const WindowBatch b = test_set->batch(idx);
+      auto gen = at::detail::createCPUGenerator(static_cast<std::uint64_t>(1000003 + chunk));
+      StepInputs in;
+      in.object = stats.normalize_object(b.object_features, b.global_states);
+      in.sample = config.model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2)
+                                            : stats.normalize_x(b.hand_features);
+      if (config.model == "motion") in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
+      in.mask = b.mask;
+      in.noise = at::randn(in.sample.sizes(), gen);
+      in.t = at::randint(0, config.diffusion_steps, {in.sample.size(0)}, gen, at::kLong);
+      const LossParts lp = step_loss(ema_net, schedule, in);
+      sum += lp.sum.item<double>();
+      frames += lp.frames;
+    }
+    return frames > 0 ? sum / frames : NAN;
+  };
+
+  TrainResult result;
+  double interval_loss = 0;
+  int interval_steps = 0;
+  std::int64_t windows_this_call = 0;
+  std::int64_t steps_this_call = 0;
+  auto t_interval = std::chrono::steady_clock::now();
+  std::int64_t windows_interval = 0;
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  const double seconds_before = rows.empty() ? 0.0 : rows.back().seconds;
+
+  while (step < config.steps) {
+    bool stop = options.stop_requested && options.stop_requested();
+    if (options.stop_after > 0 && steps_this_call >= options.stop_after) stop = true;
+    if (dp) stop = dp->all_reduce_sum(stop ? 1.0 : 0.0) > 0;
+    if (stop) {
+      result.interrupted = options.stop_requested && options.stop_requested();
+      break;
+    }
+    const StepInputs in = draw_step(config, stats, train_set, step, rank);
+    net->train();
+    const LossParts lp = step_loss(net, schedule, in);
+    const double frames = dp ? dp->all_reduce_sum(lp.frames) : lp.frames;
+    const at::Tensor loss = lp.sum / std::max(frames, 1.0);
+    opt.zero_grad();
+    loss.backward();
+    std::vector<at::Tensor> grads;
+    for (auto& p : net->parameters()) {
+      if (!p.grad().defined()) p.mutable_grad() = at::zeros_like(p);
+      grads.push_back(p.grad());
+    }
+    if (dp) dp->all_reduce_sum(grads);
+    if (config.grad_clip > 0) torch::nn::utils::clip_grad_norm_(net->parameters(), config.grad_clip);
+    const double lr = learning_rate(config, step);
+    for (auto& g : opt.param_groups()) static_cast<torch::optim::AdamOptions&>(g.options()).lr(lr);
+    opt.step();
+    {
+      torch::NoGradGuard ng;
+      const double d = std::min(config.ema, (1.0 + step) / (10.0 + step));
+      auto ema_params = ema_net->parameters();
+      auto params = net->parameters();
+      for (std::size_t i = 0; i < params.size(); ++i) ema_params[i].mul_(d).add_(params[i], 1.0 - d);
+    }
+    ++step;
+    ++steps_this_call;
+    const double loss_all = dp ? dp->all_reduce_sum(lp.sum.item<double>()) / std::max(frames, 1.0) : loss.item<double>();
+    interval_loss += loss_all;
+    ++interval_steps;
+    windows_interval += static_cast<std::int64_t>(config.batch) * world;
+    windows_this_call += static_cast<std::int64_t>(config.batch) * world;
+
+    const bool log_now = step % config.log_every == 0 || step == config.steps;
+    const bool validate_now = test_set && config.validate_every > 0 && (step % config.validate_every == 0 || step == config.steps);
+    if (root && (log_now || validate_now)) {
+      const double rate = windows_interval / std::max(since(t_interval), 1e-9);
+      LossRow r{step, lr, interval_loss / std::max(interval_steps, 1), NAN, rate,
+                seconds_before + since(t_start)};
+      if (validate_now) {
+        r.validation = validation_loss();
+        if (!(best_validation <= r.validation)) best_validation = r.validation;
+      }
+      rows.push_back(r);
+      result.last_loss = r.loss;
+      if (show) {
+        const double eta = (config.steps - step) * config.batch * world / std::max(rate, 1e-9);
+        std::string v = std::isfinite(r.validation) ? fmt::format("  validation {:.4f}", r.validation) : "";
+        log::info("step {}/{}  loss {:.4f}{}  lr {:.2e}  {:.1f} windows/s  {} left", step, config.steps, r.loss, v, lr,
+                  rate, fmt_duration(eta));
+      }
+      interval_loss = 0;
+      interval_steps = 0;
+      windows_interval = 0;
+      t_interval = std::chrono::steady_clock::now();
+    }
+    if (root && (step % config.checkpoint_every == 0 || step == config.steps)) write_checkpoint();
+  }
+  if (root && steps_this_call > 0 && step % config.checkpoint_every != 0 && step != config.steps) write_checkpoint();
+  if (root && steps_this_call == 0 && !fs::exists(checkpoint_path)) write_checkpoint();
+
+  result.steps_done = step;
+  result.finished = step >= config.steps;
+  result.seconds = since(t_start);
+  result.windows_per_second = windows_this_call / std::max(result.seconds, 1e-9);
+  result.last_validation = best_validation;
+  for (auto it = rows.rbegin(); it != rows.rend(); ++it)
+    if (std::isfinite(it->validation)) {
+      result.last_validation = it->validation;
+      break;
+    }
+  result.checkpoint = checkpoint_path;
+  if (options.final_weights != nullptr) *options.final_weights = state_of(*net);
+  if (dp) dp->barrier();
+  return result;
+}
+
+}  // namespace bimart::diffusion

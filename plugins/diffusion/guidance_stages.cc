@@ -1,0 +1,52 @@
+// guidance.contact_map (DESIGN §5, core/diffusion/contact_guidance.h) and guidance.none.
+#include <ATen/ATen.h>
+
+#include "core/diffusion/contact_guidance.h"
+#include "core/features/contact_map.h"
+#include "core/pipeline/plugin.h"
+#include "stages/guidance.h"
+
+namespace bimart {
+namespace {
+
+class ContactMapGuidanceStage : public GuidanceStage {
+ public:
+  static StageSpec spec() {
+    return StageSpec::of<GuidanceStage>("contact_map",
+                                        "pulls the keypoints' contact map onto C at every diffusion step")
+        .param("scale", 1.0, "norm of the correction per sample (λ_c = scale / ||∇||); 0 = off")
+        .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
+  }
+  explicit ContactMapGuidanceStage(const Params& p) : scale_(p.number("scale")) {
+    if (!(scale_ >= 0)) throw Error("'scale' must not be negative");
+  }
+  void run(StageIO& io) override {
+    const at::Tensor points = basis_hit_points(io.in<ArticulatedObject>("object"), io.in<at::Tensor>("object_states"),
+                                               io.in<at::Tensor>("basis_hit_indices"));
+    const at::Tensor target = io.has("contact_maps_samples") ? io.in<at::Tensor>("contact_maps_samples")
+                                                             : io.in<at::Tensor>("contact_maps");
+    io.out("guidance", std::shared_ptr<const Guidance>(
+                           std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_)));
+  }
+
+ private:
+  double scale_;
+};
+
+class NoGuidance : public Guidance {
+ public:
+  at::Tensor correction(const at::Tensor& x0, std::int64_t, int, int) const override { return at::zeros_like(x0); }
+};
+
+class NoGuidanceStage : public GuidanceStage {
+ public:
+  static StageSpec spec() { return StageSpec::of<GuidanceStage>("none", "no guidance (a zero correction)"); }
+  explicit NoGuidanceStage(const Params&) {}
+  void run(StageIO& io) override { io.out("guidance", std::shared_ptr<const Guidance>(std::make_shared<NoGuidance>())); }
+};
+
+}  // namespace
+}  // namespace bimart
+
+BIMART_REGISTER_STAGE(bimart::ContactMapGuidanceStage)
+BIMART_REGISTER_STAGE(bimart::NoGuidanceStage)

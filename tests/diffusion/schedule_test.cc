@@ -1,0 +1,131 @@
+// Noise schedules against their closed forms; samplers with a perfect x0 predictor; CFG.
+#include <gtest/gtest.h>
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <cmath>
+
+#include "core/diffusion/sampler.h"
+#include "core/diffusion/schedule.h"
+#include "core/util/error.h"
+
+namespace bimart::diffusion {
+namespace {
+
+double cosine_f(double t, int T) {
+  const double c = std::cos((t / T + 0.008) / 1.008 * M_PI / 2.0);
+  return c * c;
+}
+
+TEST(Schedule, CosineAlphaBarMatchesTheClosedForm) {
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  ASSERT_EQ(s.betas.size(), 50u);
+  for (int t = 0; t < 50; ++t) {
+    if (s.betas[t] >= 0.999) break;  // the cap, at the very end only
+    EXPECT_NEAR(s.alphas_cumprod[t], cosine_f(t + 1, 50) / cosine_f(0, 50), 1e-12) << "t = " << t;
+  }
+  EXPECT_LT(s.alphas_cumprod[0], 1.0);
+  EXPECT_GT(s.alphas_cumprod[0], 0.99);   // almost clean at t = 0
+  EXPECT_LT(s.alphas_cumprod[49], 1e-3);  // almost pure noise at T - 1
+  for (int t = 1; t < 50; ++t) EXPECT_LT(s.alphas_cumprod[t], s.alphas_cumprod[t - 1]);
+}
+
+TEST(Schedule, LinearBetasAndProduct) {
+  const NoiseSchedule s = make_schedule("linear", 50);
+  EXPECT_NEAR(s.betas.front(), 20 * 1e-4, 1e-15);
+  EXPECT_NEAR(s.betas.back(), 20 * 0.02, 1e-15);
+  double prod = 1;
+  for (int t = 0; t < 50; ++t) {
+    prod *= 1 - (20e-4 + (0.4 - 20e-4) * t / 49.0);
+    EXPECT_NEAR(s.alphas_cumprod[t], prod, 1e-12);
+  }
+}
+
+TEST(Schedule, RejectsUnknownNamesAndSteps) {
+  EXPECT_THROW(make_schedule("cosine", 50), Error);
+  EXPECT_THROW(make_schedule("linear", 0), Error);
+}
+
+TEST(Schedule, AddNoiseIsTheClosedForm) {
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const at::Tensor x0 = at::randn({3, 4, 5});
+  const at::Tensor eps = at::randn({3, 4, 5});
+  const at::Tensor t = at::tensor({0, 10, 49}, at::kLong);
+  const at::Tensor xt = add_noise(s, x0, eps, t);
+  for (int b = 0; b < 3; ++b) {
+    const double a = s.alphas_cumprod[t[b].item<int64_t>()];
+    EXPECT_TRUE(at::allclose(xt[b], std::sqrt(a) * x0[b] + std::sqrt(1 - a) * eps[b], 1e-5, 1e-6));
+  }
+}
+
+TEST(Schedule, PosteriorMeanOfANoiseFreeSampleIsTheScaledData) {
+  // x_t = sqrt(ᾱ_t) x0 exactly -> the posterior mean is sqrt(ᾱ_{t-1}) x0.
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  for (int t : {1, 5, 25, 49}) {
+    const Posterior p = posterior(s, t);
+    EXPECT_NEAR(p.c0 + p.ct * std::sqrt(s.alphas_cumprod[t]), std::sqrt(s.alphas_cumprod[t - 1]), 1e-12) << t;
+    EXPECT_GT(p.variance, 0);
+  }
+  EXPECT_NEAR(posterior(s, 0).variance, 0.0, 1e-15);
+}
+
+TEST(Sampler, TimestepsOfDdpmAndDdim) {
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const auto ddpm = sampling_timesteps(s, {"ddpm", 0, 0});
+  ASSERT_EQ(ddpm.size(), 50u);
+  EXPECT_EQ(ddpm.front(), 49);
+  EXPECT_EQ(ddpm.back(), 0);
+  const auto ddim = sampling_timesteps(s, {"ddim", 10, 0});
+  ASSERT_EQ(ddim.size(), 10u);
+  EXPECT_EQ(ddim.front(), 49);
+  EXPECT_EQ(ddim.back(), 0);
+  for (std::size_t i = 1; i < ddim.size(); ++i) EXPECT_LT(ddim[i], ddim[i - 1]);
+  EXPECT_THROW(sampling_timesteps(s, {"ddim", 51, 0}), Error);
+  EXPECT_THROW(sampling_timesteps(s, {"euler", 0, 0}), Error);
+}
+
+class PerfectPredictor : public ::testing::TestWithParam<SamplerOptions> {};
+
+TEST_P(PerfectPredictor, ReturnsTheData) {
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const at::Tensor data = at::randn({2, 8, 6});
+  int calls = 0;
+  const Predictor perfect = [&](const at::Tensor& x, int) {
+    ++calls;
+    EXPECT_TRUE(at::isfinite(x).all().item<bool>());
+    return data.clone();
+  };
+  auto gen = at::detail::createCPUGenerator(3);
+  const at::Tensor out = sample(s, perfect, at::randn({2, 8, 6}, gen), GetParam(), gen);
+  EXPECT_TRUE(at::allclose(out, data, 0, 0));
+  EXPECT_EQ(calls, static_cast<int>(sampling_timesteps(s, GetParam()).size()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Samplers, PerfectPredictor,
+                         ::testing::Values(SamplerOptions{"ddpm", 0, 0}, SamplerOptions{"ddim", 10, 0},
+                                           SamplerOptions{"ddim", 10, 1.0}));
+
+TEST(Sampler, DdpmStepsTowardTheDataWithAPerfectPredictor) {
+  // The iterates approach the data: the distance after the second-last step is far below
+  // the starting noise's.
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const at::Tensor data = at::randn({1, 16, 4});
+  double before_last = 0;
+  auto gen = at::detail::createCPUGenerator(4);
+  const at::Tensor x_T = at::randn({1, 16, 4}, gen);
+  sample(s, [&](const at::Tensor&, int) { return data; }, x_T, {"ddpm", 0, 0}, gen,
+         [&](int done, int total, at::Tensor& x) {
+           if (done == total - 1) before_last = (x - data).norm().item<double>();
+         });
+  EXPECT_LT(before_last, 0.2 * (x_T - data).norm().item<double>());
+}
+
+TEST(Cfg, LambdaZeroIsTheConditionalOutput) {
+  const at::Tensor c = at::randn({2, 3}), u = at::randn({2, 3});
+  EXPECT_TRUE(at::equal(combine_cfg(c, u, 0.0), c));
+  EXPECT_TRUE(at::allclose(combine_cfg(c, u, 0.5), 1.5 * c - 0.5 * u));
+}
+
+}  // namespace
+}  // namespace bimart::diffusion

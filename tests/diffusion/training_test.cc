@@ -1,0 +1,231 @@
+// Training on the tiny data set: the config file, an interrupted run resumes to the
+// identical loss curve and weights, and two processes on loopback train exactly like one
+// process on the union of their batches.
+#include <gtest/gtest.h>
+
+#include <torch/optim/adam.h>
+
+#include <ATen/ATen.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "core/data/normalization.h"
+#include "core/diffusion/checkpoint.h"
+#include "core/diffusion/distributed.h"
+#include "core/diffusion/schedule.h"
+#include "core/diffusion/training.h"
+#include "core/util/error.h"
+#include "tests/data/tiny_dataset.h"
+
+namespace bimart::diffusion {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("bimart_train_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TrainConfig tiny_config(const fs::path& out, const std::string& model = "motion") {
+  TrainConfig c;
+  c.model = model;
+  c.data = testing_data::tiny_dataset().dir.string();
+  c.out = out.string();
+  c.network = DenoiserConfig::paper(model);
+  c.network.latent = 16;
+  c.network.layers = 1;
+  c.network.heads = 2;
+  c.network.feedforward = 32;
+  c.network.condition_hidden = 16;
+  c.network.dropout = 0.1;
+  c.batch = 3;
+  c.steps = 6;
+  c.lr = 1e-3;
+  c.warmup = 2;
+  c.checkpoint_every = 3;
+  c.validate_every = 3;
+  c.validation_windows = 4;
+  c.log_every = 1;
+  c.seed = 11;
+  return c;
+}
+
+std::vector<std::string> lines(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> v;
+  for (std::string l; std::getline(in, l);) v.push_back(l);
+  return v;
+}
+
+// The loss columns (step, lr, loss, validation) of loss.csv; time and rate differ per run.
+std::vector<std::string> loss_columns(const fs::path& file) {
+  std::vector<std::string> out;
+  for (const auto& l : lines(file)) {
+    std::size_t pos = 0;
+    for (int i = 0; i < 4 && pos != std::string::npos; ++i) pos = l.find(',', pos + 1);
+    out.push_back(l.substr(0, pos));
+  }
+  return out;
+}
+
+TEST(Training, ConfigFileErrorsNameTheLine) {
+  const fs::path dir = scratch("config");
+  const fs::path good = dir / "good.yaml";
+  std::ofstream(good) << "model: contact\ndata: d\nout: o\nnetwork:\n  latent: 64\n  heads: 4\ntraining:\n  steps: 7\n";
+  const TrainConfig c = load_train_config(good.string());
+  EXPECT_EQ(c.model, "contact");
+  EXPECT_EQ(c.network.latent, 64);
+  EXPECT_EQ(c.network.sample_size, 2048);
+  EXPECT_EQ(c.network.contact_condition_size, 0);
+  EXPECT_EQ(c.steps, 7);
+  EXPECT_NE(c.text.find("latent: 64"), std::string::npos);
+  const fs::path bad = dir / "bad.yaml";
+  std::ofstream(bad) << "model: motion\ndata: d\nout: o\ntraining:\n  stepz: 7\n";
+  try {
+    load_train_config(bad.string());
+    FAIL() << "accepted an unknown key";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:5"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("stepz"), std::string::npos) << e.what();
+  }
+  std::ofstream(bad) << "model: motion\ndata: d\nout: o\nnetwork:\n  heads: 7\n";
+  EXPECT_THROW(load_train_config(bad.string()), Error);  // 7 does not divide 512
+}
+
+TEST(Training, LearningRateWarmsUpThenDecays) {
+  TrainConfig c;
+  c.lr = 1e-3;
+  c.warmup = 10;
+  c.steps = 110;
+  EXPECT_NEAR(learning_rate(c, 0), 1e-4, 1e-15);
+  EXPECT_NEAR(learning_rate(c, 9), 1e-3, 1e-15);
+  EXPECT_NEAR(learning_rate(c, 10), 1e-3, 1e-15);
+  EXPECT_NEAR(learning_rate(c, 60), 0.5e-3, 1e-12);
+  EXPECT_NEAR(learning_rate(c, 110), 0.0, 1e-15);
+}
+
+TEST(Training, ResumedRunEqualsAnUninterruptedOne) {
+  const fs::path a = scratch("whole"), b = scratch("parts");
+  TrainOptions quiet;
+  quiet.progress = false;
+  TensorMap wa, wb;
+  TrainOptions oa = quiet;
+  oa.final_weights = &wa;
+  const TrainResult ra = train(tiny_config(a), oa);
+  EXPECT_TRUE(ra.finished);
+  EXPECT_EQ(ra.steps_done, 6);
+
+  TrainOptions first = quiet;
+  first.stop_after = 4;  // not on a checkpoint boundary: the stop writes one
+  const TrainResult r1 = train(tiny_config(b), first);
+  EXPECT_FALSE(r1.finished);
+  EXPECT_EQ(r1.steps_done, 4);
+  TrainOptions rest = quiet;
+  rest.resume = true;
+  rest.final_weights = &wb;
+  const TrainResult r2 = train(tiny_config(b), rest);
+  EXPECT_TRUE(r2.finished);
+  EXPECT_EQ(r2.steps_done, 6);
+
+  const auto la = loss_columns(a / "loss.csv"), lb = loss_columns(b / "loss.csv");
+  ASSERT_EQ(la.size(), 7u);  // header + 6 steps
+  EXPECT_EQ(la, lb);
+  ASSERT_EQ(wa.size(), wb.size());
+  for (const auto& [k, v] : wa) EXPECT_TRUE(at::equal(v, wb.at(k))) << k;
+  const Checkpoint ca = load_checkpoint((a / "checkpoint.npz").string());
+  const Checkpoint cb = load_checkpoint((b / "checkpoint.npz").string());
+  for (const auto& [k, v] : ca.weights) EXPECT_TRUE(at::equal(v, cb.weights.at(k))) << "EMA " << k;
+  ASSERT_TRUE(ca.train.has_value());
+  EXPECT_EQ(ca.train->step, 6);
+  EXPECT_EQ(ca.info.keypoints.size(), 100u);
+  EXPECT_EQ(ca.info.basis_points.sizes(), (std::vector<int64_t>{1024, 3}));
+}
+
+TEST(Training, ResumeRefusesAnotherNetwork) {
+  const fs::path dir = scratch("other_net");
+  TrainOptions o;
+  o.progress = false;
+  TrainConfig c = tiny_config(dir);
+  c.steps = 2;
+  train(c, o);
+  c.network.latent = 32;
+  o.resume = true;
+  EXPECT_THROW(train(c, o), Error);
+}
+
+TEST(Training, TwoProcessesEqualOneOnTheUnionOfTheirBatches) {
+  const fs::path dir = scratch("parallel");
+  TrainConfig c = tiny_config(dir, "motion");
+  c.network.dropout = 0.0;  // dropout masks depend on the batch layout
+  c.grad_clip = 0.0;
+  c.batch = 2;
+  c.steps = 3;
+  c.validate_every = 0;
+  const int port = 20000 + static_cast<int>(::getpid() % 20000);
+  TensorMap w[2];
+  std::string errors[2];
+  std::vector<std::thread> ranks;
+  for (int r = 0; r < 2; ++r) {
+    ranks.emplace_back([&, r] {
+      try {
+        DataParallelOptions d;
+        d.world_size = 2;
+        d.rank = r;
+        d.master_port = port;
+        d.timeout_seconds = 60;
+        TrainOptions o;
+        o.progress = false;
+        o.parallel = std::make_shared<DataParallel>(d);
+        o.final_weights = &w[r];
+        train(c, o);
+      } catch (const std::exception& e) {
+        errors[r] = e.what();
+      }
+    });
+  }
+  for (auto& t : ranks) t.join();
+  ASSERT_EQ(errors[0], "");
+  ASSERT_EQ(errors[1], "");
+  for (const auto& [k, v] : w[0]) EXPECT_TRUE(at::equal(v, w[1].at(k))) << "ranks differ in " << k;
+
+  // One process, the union of both ranks' batches, the same steps.
+  WindowDatasetOptions wo;
+  const WindowDataset data = WindowDataset::open(c.data, "train", wo);
+  const NormalizationStats stats = compute_normalization(data);
+  const NoiseSchedule schedule = make_schedule(c.schedule, c.diffusion_steps);
+  torch::manual_seed(c.seed);
+  Denoiser net(c.network);
+  torch::optim::Adam opt(net->parameters(), torch::optim::AdamOptions(c.lr));
+  for (std::int64_t step = 0; step < c.steps; ++step) {
+    const StepInputs a = draw_step(c, stats, data, step, 0), b = draw_step(c, stats, data, step, 1);
+    StepInputs u;
+    u.sample = at::cat({a.sample, b.sample});
+    u.object = at::cat({a.object, b.object});
+    u.contact = at::cat({a.contact, b.contact});
+    u.use_contact = at::cat({a.use_contact, b.use_contact});
+    u.mask = at::cat({a.mask, b.mask});
+    u.noise = at::cat({a.noise, b.noise});
+    u.t = at::cat({a.t, b.t});
+    const LossParts lp = step_loss(net, schedule, u);
+    opt.zero_grad();
+    (lp.sum / lp.frames).backward();
+    for (auto& p : net->parameters())  // as train(): unused parameters get a zero gradient
+      if (!p.grad().defined()) p.mutable_grad() = at::zeros_like(p);
+    for (auto& g : opt.param_groups())
+      static_cast<torch::optim::AdamOptions&>(g.options()).lr(learning_rate(c, step));
+    opt.step();
+  }
+  double worst = 0;
+  for (const auto& p : net->named_parameters())
+    worst = std::max(worst, (p.value() - w[0].at(p.key())).abs().max().item<double>());
+  EXPECT_LE(worst, 1e-5);
+}
+
+}  // namespace
+}  // namespace bimart::diffusion
