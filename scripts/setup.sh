@@ -12,6 +12,7 @@ packages=(
   libtinygltf-dev libzip-dev libstb-dev             # glTF export; .npz files; PNG pictures
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy                              # tools/ converters (numpy only)
+  blender chromium                                   # output tests: glTF import, viewer page (docs/outputs.md)
 )
 
 missing=()
@@ -20,6 +21,11 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+
+# node and npm (viewer bundle, glTF validator, Chromium driver): Debian's unless some
+# other install already provides the commands (e.g. NodeSource's nodejs, which bundles npm).
+command -v node >/dev/null || missing+=(nodejs)
+command -v npm >/dev/null || missing+=(npm)
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages already installed"

@@ -29,4 +29,5 @@ void add_data_commands(CLI::App& app, Commands& out);      // data synth, data s
 void add_refine_commands(CLI::App& app, Commands& out);    // refine
 void add_train_commands(CLI::App& app, Commands& out);     // train
 void add_generate_commands(CLI::App& app, Commands& out);  // generate
+void add_export_commands(CLI::App& app, Commands& out);    // export, view, render
 }  // namespace bimart::cli

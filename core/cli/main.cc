@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   bimart::cli::add_refine_commands(app, commands);
   bimart::cli::add_train_commands(app, commands);
   bimart::cli::add_generate_commands(app, commands);
+  bimart::cli::add_export_commands(app, commands);
 
   bimart::runtime::set_threads(0);  // all cores, also for what --version reports
   CLI11_PARSE(app, argc, argv);

@@ -1,0 +1,54 @@
+// export.html: the viewer page for one sequence (core/export/viewer_page.h).
+#include <filesystem>
+
+#include "core/export/gltf_scene.h"
+#include "core/export/viewer_page.h"
+#include "core/util/log.h"
+#include "plugins/outputs/stage_inputs.h"
+#include "stages/exporter.h"
+
+namespace bimart {
+namespace {
+
+class HtmlExport : public Exporter {
+ public:
+  static StageSpec spec() {
+    StageSpec s = StageSpec::of<Exporter>("html", "a self-contained viewer page (three.js, no network)");
+    outputs_plugin::declare_scene_inputs(s);
+    s.param("path", "out/viewer.html", "file to write (folders are created)")
+        .param("correctives", true, "pose correctives as morph targets in the embedded scene");
+    return s;
+  }
+  explicit HtmlExport(const Params& p)
+      : path_(p.string("path")), name_(p.string("name")), correctives_(p.boolean("correctives")),
+        hands_(load_export_hands(p.string("mano_left"), p.string("mano_right"))) {
+    if (path_.empty()) throw Error("path must not be empty");
+    viewer_bundle_path();  // fails before any work when the script is missing
+  }
+  void run(StageIO& io) override {
+    const std::string name = name_.empty() ? std::filesystem::path(path_).stem().string() : name_;
+    const SceneSource src = outputs_plugin::scene_from_inputs(io, hands_, name);
+    GltfOptions o;
+    o.correctives = correctives_;
+    ViewerSample sample;
+    sample.name = name;
+    sample.fps = src.sequence.fps;
+    sample.frames = src.sequence.num_frames();
+    sample.glb = build_glb(src.sequence, src.object, src.models(), o);
+    sample.contacts = viewer_contacts(src.sequence);
+    sample.top_vertices = src.object.top.num_vertices();
+    const auto bytes = write_viewer_page({sample}, name, path_);
+    log::info("{}: {:.2f} MB", path_, bytes / 1e6);
+    io.out("path", path_);
+  }
+
+ private:
+  std::string path_, name_;
+  bool correctives_;
+  std::shared_ptr<const std::array<HandModel, 2>> hands_;
+};
+
+}  // namespace
+}  // namespace bimart
+
+BIMART_REGISTER_STAGE(bimart::HtmlExport)
