@@ -1,6 +1,8 @@
 #include "core/io/npz.h"
 
+#include <fmt/format.h>
 #include <zip.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
@@ -410,6 +412,14 @@ NpzFile NpzFile::read(const std::string& path) {
       got += static_cast<zip_uint64_t>(r);
     }
     if (got != st.size) throw Error(what + ": truncated member");
+    // libzip checks the CRC only when a read reaches the end of the member, which reading
+    // exactly st.size bytes never does; numpy checks it, so do we.
+    if (st.valid & ZIP_STAT_CRC) {
+      const uLong crc = crc32_z(crc32_z(0L, Z_NULL, 0), bytes.data(), bytes.size());
+      if (crc != st.crc)
+        throw Error(fmt::format("{}: corrupt member (CRC-32 {:08x}, the archive says {:08x}); the file is damaged",
+                                what, crc, st.crc));
+    }
     npz.arrays_[key] = parse_npy(bytes.data(), bytes.size(), what);
   }
   return npz;

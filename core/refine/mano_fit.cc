@@ -216,13 +216,6 @@ void ManoFitOptions::validate() const {
   if (threads < 0) throw Error("mano fit: threads must be >= 0 (0 = all cores)");
 }
 
-std::vector<int> model_keypoints(const HandModel& model) {
-  std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model, kJ) : model.keypoints;
-  if (static_cast<int>(ids.size()) != kJ)
-    throw Error("hand model has " + std::to_string(ids.size()) + " keypoints, expected " +
-                std::to_string(kJ));
-  return ids;
-}
 
 HandMotion fit_mano(const std::array<const HandModel*, 2>& models, const at::Tensor& keypoints_world,
                     const ManoFitOptions& options, ManoFitReport* report) {
