@@ -8,8 +8,9 @@ packages=(
   libtorch-dev libopenblas0-openmp        # networks; OpenMP OpenBLAS (DESIGN §8)
   libeigen3-dev libyaml-cpp-dev libcgal-dev libceres-dev
   libfmt-dev libspdlog-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
-  libtinygltf-dev libzip-dev libstb-dev             # glTF export; .npz files; PNG pictures
+  libtinygltf-dev libzip-dev zlib1g-dev libstb-dev  # glTF export; .npz files (zlib: CRCs); PNG pictures
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev                           # libFuzzer harnesses (scripts/test.sh --fuzz)
   python3 python3-numpy                              # tools/ converters (numpy only)
 )
 
