@@ -10,6 +10,7 @@
 #include "core/pipeline/graph.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
+#include "core/util/yaml_keys.h"
 #include "tests/robust/fixture.h"
 
 namespace bimart {
@@ -64,6 +65,8 @@ TEST(YamlKeys, DuplicateKeysAreErrorsNamingBothLines) {
   const std::string flow = "name: dup\nstages:\n  - {id: a, use: trajectory.constant, id: b}\n";
   const std::string f = error_of([&] { GraphFile::parse(flow, "q.yaml", ""); });
   EXPECT_NE(f.find("q.yaml:3:39: key 'id' is given twice (first at line 3)"), std::string::npos) << f;
+  // Found by fuzzing: the duplicate check looped forever on this input.
+  EXPECT_NO_THROW(check_duplicate_keys(",ame:", "t.yaml"));
   // The same key in two different maps is fine.
   EXPECT_NO_THROW(GraphFile::parse("stages:\n  - {id: a, use: x.y}\n  - {id: b, use: x.y}\n", "r.yaml", ""));
 }
