@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 
 #include <chrono>
+#include <cstdlib>
 
 #include "tests/cli/run_bimart.h"
 #include "tests/robust/fixture.h"
@@ -138,6 +139,12 @@ TEST(CliConventions, BpsMakeRefusesToOverwriteWithoutForce) {
   std::string kept;
   in >> kept;
   EXPECT_EQ(kept, "shipped");
+}
+
+TEST(CliConventions, InterruptedExitsWith130) {
+  const std::string cmd = "timeout --preserve-status -s INT 5 " + std::string(BIMART_CLI) +
+                          " bench blas --size 1024 --repeats 1000000 > /dev/null 2>&1";
+  EXPECT_EQ(exit_code(std::system(cmd.c_str())), 130);
 }
 
 TEST(CliConventions, HugeFrameCountIsRefusedUpFront) {
