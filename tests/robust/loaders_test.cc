@@ -51,6 +51,13 @@ TEST(NpzCrc, FlippedBytesInAStoredMemberAreRefused) {
   EXPECT_NE(e.find("array 'values': corrupt member (CRC-32"), std::string::npos) << e;  // was read as valid data
 }
 
+TEST(NpzSizes, DeclaredMemberSizesAreBoundedByTheFile) {
+  // Found by fuzzing: a 3 KB archive whose directory declares a 3 GB member, allocated at once.
+  const std::string file = std::string(BIMART_SOURCE_DIR) + "/tests/fuzz/regressions/sequence/oom_declared_member_size.npz";
+  const std::string e = error_of([&] { NpzFile::read(file); });
+  EXPECT_NE(e.find("more than its 2977 bytes can hold"), std::string::npos) << e;
+}
+
 TEST(YamlKeys, DuplicateKeysAreErrorsNamingBothLines) {
   const std::string block =
       "name: dup\n"
