@@ -9,8 +9,9 @@ packages=(
   libgloo-dev                             # headers of libtorch's distributed (c10d/Gloo) training
   libeigen3-dev libyaml-cpp-dev libcgal-dev libceres-dev
   libfmt-dev libspdlog-dev libcli11-dev nlohmann-json3-dev libnanoflann-dev
-  libtinygltf-dev libzip-dev libstb-dev             # glTF export; .npz files; PNG pictures
+  libtinygltf-dev libzip-dev zlib1g-dev libstb-dev  # glTF export; .npz files (zlib: CRCs); PNG pictures
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev                           # libFuzzer harnesses (scripts/test.sh --fuzz)
   python3 python3-numpy                              # tools/ converters (numpy only)
   blender chromium                                   # output tests: glTF import, viewer page (docs/outputs.md)
 )

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "core/cli/command.h"
+#include "core/cli/common_options.h"
 #include "core/cli/data_stats_command.h"
 #include "core/object/families/families.h"
 #include "core/synth/dataset.h"
@@ -17,11 +18,10 @@ void add_data_commands(CLI::App& app, Commands& out) {
   data->require_subcommand(1);
 
   static SynthOptions o;
-  static bool quiet = false;
   CLI::App* synth = data->add_subcommand(
       "synth", "write a synthetic data set: objects, grab/use trajectories, bimanual hands, manifest");
   synth->add_option("--out", o.out, "data set folder (created; must be empty unless --force)")->required();
-  synth->add_option("--seed", o.seed, "data set seed: the same seed writes byte-identical files")->capture_default_str();
+  add_seed_option(synth, o.seed, "data set seed: the same seed writes byte-identical files (default 1)");
   synth->add_option("--categories", o.categories, "object categories (default: all): " + join(object_categories(), ", "))
       ->delimiter(',');
   synth->add_option("--train-objects", o.train_objects, "object instances per category in the train split")
@@ -37,12 +37,10 @@ void add_data_commands(CLI::App& app, Commands& out) {
       ->capture_default_str();
   synth->add_option("--mano-left", o.mano_left, "left hand model .npz (default: the shipped procedural hand)");
   synth->add_option("--mano-right", o.mano_right, "right hand model .npz (default: the shipped procedural hand)");
-  synth->add_option("--threads", o.threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   synth->add_flag("--force", o.force, "replace the data set already in --out");
-  synth->add_flag("--quiet", quiet, "no progress bar");
   out.push_back({synth,
                  [] {
-                   o.progress = !quiet;
+                   o.progress = true;  // -q turns every progress bar off
                    const SynthSummary s = synthesize_dataset(o);
                    std::cout << fmt::format(
                        "wrote {}: {} objects, {} train + {} test sequences, {} frames, in {:.1f} s{}\n", o.out,
@@ -53,20 +51,16 @@ void add_data_commands(CLI::App& app, Commands& out) {
                  },
                  false});
   static std::string check_folder, check_split = "test", check_left, check_right;
-  static int check_threads = 0;
-  static bool check_quiet = false;
   CLI::App* check = data->add_subcommand(
       "check", "both hands in contact while the object moves, who drives use sequences, hand-hand depth");
   check->add_option("folder", check_folder, "data set folder (with manifest.json)")->required();
   check->add_option("--split", check_split, "train or test")->capture_default_str();
-  check->add_option("--threads", check_threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   check->add_option("--mano-left", check_left, "left hand model .npz to pose the hands with (default: shipped)");
   check->add_option("--mano-right", check_right, "right hand model .npz (give both)");
-  check->add_flag("--quiet", check_quiet, "no progress bar");
   out.push_back({check,
                  [] {
                    const DatasetCheck c =
-                       check_dataset(check_folder, check_split, check_threads, !check_quiet, 2, check_left, check_right);
+                       check_dataset(check_folder, check_split, 0, true, 2, check_left, check_right);
                    const auto pct = [](double a, double b) { return b > 0 ? 100.0 * a / b : 0.0; };
                    std::cout << fmt::format(
                        "{} {} sequences\n"

@@ -16,6 +16,7 @@
 #include "core/data/normalization.h"
 #include "core/data/window_dataset.h"
 #include "core/util/error.h"
+#include "core/util/progress.h"
 
 namespace bimart::cli {
 namespace {
@@ -38,7 +39,7 @@ int run_stats(const StatsOptions& o) {
   opt.basis_file = o.basis;
   opt.stride = o.stride;
   opt.cache = !o.no_cache;
-  const bool show = isatty(STDERR_FILENO);
+  const bool show = isatty(STDERR_FILENO) && progress_enabled();
   opt.progress = [show](std::size_t done, std::size_t total) {
     if (!show) return;
     const int width = 30, filled = static_cast<int>(width * done / total);

@@ -30,6 +30,8 @@
 #include "core/runtime/blas.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
+#include "core/util/log.h"
+#include "core/util/output_path.h"
 #include "core/util/parallel.h"
 #include "core/util/progress.h"
 
@@ -45,6 +47,7 @@ struct SetResult {
   std::vector<double> mul;  // per trajectory with >= 2 samples
   size_t trajectories = 0;
   std::vector<MetricResult> table;
+  std::vector<std::pair<std::string, std::string>> skipped;  // --keep-going: file, why
 };
 
 SequenceData sequence_data(const Sequence& s, bool keypoints) {
@@ -69,26 +72,48 @@ std::string trajectory_key(const Sequence& s, const std::string& object_path) {
 }
 
 SetResult evaluate_set(const std::string& label, const std::string& folder, const std::string& split,
-                       int threads, bool progress, ObjectCache& objects) {
+                       int threads, bool keep_going, ObjectCache& objects) {
   SetResult r;
   r.label = label;
   r.folder = folder;
-  r.files = sequence_files(folder, split);
-  const size_t n = r.files.size();
-  r.sequences.resize(n);
-  std::vector<std::string> keys(n);
+  std::vector<std::string> files = sequence_files(folder, split);
+  const size_t total = files.size();
+  std::vector<SequenceMetrics> sequences(total);
+  std::vector<std::string> all_keys(total), errors(total);
   {
-    ProgressBar bar(label, n, progress);
-    parallel_for(n, threads, [&](size_t i) {
-      const Sequence s = read_sequence(r.files[i]);
-      const std::string object_path = resolve_object_path(s, r.files[i]);
-      const auto entry = objects.get(object_path);
-      r.sequences[i] = evaluate_sequence(entry->object, *entry->distance, sequence_data(s, true));
-      if (r.sequences[i].name.empty()) r.sequences[i].name = fs::path(r.files[i]).stem().string();
-      keys[i] = trajectory_key(s, object_path);
+    ProgressBar bar(label, total, true);
+    parallel_for(total, threads, [&](size_t i) {
+      try {
+        const Sequence s = read_sequence(files[i]);
+        const auto entry = sequence_object(objects, s, files[i]);
+        try {
+          sequences[i] = evaluate_sequence(entry->object, *entry->distance, sequence_data(s, true));
+        } catch (const Error& e) {
+          throw in_sequence_file(files[i], e);
+        }
+        if (sequences[i].name.empty()) sequences[i].name = fs::path(files[i]).stem().string();
+        all_keys[i] = trajectory_key(s, resolve_object_path(s, files[i]));
+      } catch (const Error& e) {
+        if (!keep_going) throw;
+        errors[i] = e.what();  // one slot per file: no lock needed
+      }
       bar.step();
     });
   }
+  // --keep-going: the bad files are listed and left out; the rest is evaluated as usual.
+  std::vector<std::string> keys;
+  for (size_t i = 0; i < total; ++i) {
+    if (!errors[i].empty()) {
+      r.skipped.push_back({files[i], errors[i]});
+      log::warn("skipped {}", errors[i]);
+      continue;
+    }
+    r.files.push_back(files[i]);
+    r.sequences.push_back(sequences[i]);
+    keys.push_back(all_keys[i]);
+  }
+  const size_t n = r.files.size();
+  if (n == 0) throw Error(folder + ": every one of the " + std::to_string(total) + " sequence files was refused");
   // Mul: trajectories with several samples, files re-read (vertices are not kept in memory).
   std::map<std::string, std::vector<size_t>> groups;
   for (size_t i = 0; i < n; ++i) groups[keys[i]].push_back(i);
@@ -99,7 +124,13 @@ SetResult evaluate_set(const std::string& label, const std::string& folder, cons
   r.mul.resize(multi.size());
   parallel_for(multi.size(), threads, [&](size_t g) {
     std::vector<at::Tensor> samples;
-    for (size_t i : multi[g]) samples.push_back(hand_vertices(read_sequence(r.files[i]).hands));
+    for (size_t i : multi[g]) {
+      try {
+        samples.push_back(hand_vertices(read_sequence(r.files[i]).hands));
+      } catch (const Error& e) {
+        throw in_sequence_file(r.files[i], e);
+      }
+    }
     r.mul[g] = multimodality(samples);
   });
   r.table = aggregate_metrics(r.sequences, r.mul);
@@ -131,8 +162,9 @@ void print_table(const std::vector<SetResult>& sets) {
   std::cout << "units: Mul cm, Accel cm/frame², Pen/Con/Art % of frames (passing/considered), CM cm; "
                "'-' = nothing to measure\n";
   for (const auto& s : sets)
-    std::cout << fmt::format("{}: {} sequences, {} trajectories, {} with several samples (Mul)\n", s.label,
-                             s.sequences.size(), s.trajectories, s.mul.size());
+    std::cout << fmt::format("{}: {} sequences, {} trajectories, {} with several samples (Mul){}\n", s.label,
+                             s.sequences.size(), s.trajectories, s.mul.size(),
+                             s.skipped.empty() ? "" : fmt::format("; {} files skipped (bad input)", s.skipped.size()));
 }
 
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
@@ -143,6 +175,8 @@ nlohmann::json to_json(const SetResult& s) {
   j["sequences"] = s.sequences.size();
   j["trajectories"] = s.trajectories;
   j["trajectories_with_samples"] = s.mul.size();
+  j["skipped"] = nlohmann::json::array();
+  for (const auto& [file, why] : s.skipped) j["skipped"].push_back({{"file", file}, {"error", why}});
   for (const auto& m : s.table) {
     nlohmann::json c{{"name", m.name}, {"value", number(m.value)}, {"unit", m.unit},
                      {"higher_is_better", m.higher_is_better}, {"num_sequences", m.num_sequences}};
@@ -165,24 +199,25 @@ nlohmann::json to_json(const SetResult& s) {
 
 struct EvalOptions {
   std::string folder, ground_truth, split, json, mano_left, mano_right;
-  int threads = 0;
-  bool quiet = false;
+  bool keep_going = false;
 };
 
 int eval(const EvalOptions& o) {
   if (o.folder.empty() && o.ground_truth.empty())
     throw Error("bimart eval: give a folder of sequences and/or --ground-truth DATASET");
-  const int threads = resolve_threads(o.threads);
+  const int threads = resolve_threads(0);  // the global --threads, else all cores
+  if (!o.json.empty()) check_output_file(o.json);
   // One sequence per thread: libtorch's own intra-op threads would only oversubscribe.
   runtime::set_threads(1);
   if (!o.mano_left.empty() || !o.mano_right.empty()) set_posing_hand_models(o.mano_left, o.mano_right);
-  const bool progress = !o.quiet;
   ObjectCache objects;
   std::vector<SetResult> sets;
-  if (!o.folder.empty()) sets.push_back(evaluate_set("generated", o.folder, o.split, threads, progress, objects));
+  if (!o.folder.empty()) sets.push_back(evaluate_set("generated", o.folder, o.split, threads, o.keep_going, objects));
   if (!o.ground_truth.empty())
-    sets.push_back(evaluate_set("ground truth", o.ground_truth, o.split, threads, progress, objects));
+    sets.push_back(evaluate_set("ground truth", o.ground_truth, o.split, threads, o.keep_going, objects));
   print_table(sets);
+  size_t skipped = 0;
+  for (const auto& s : sets) skipped += s.skipped.size();
   if (!o.json.empty()) {
     nlohmann::json j;
     j["threads"] = threads;
@@ -191,7 +226,12 @@ int eval(const EvalOptions& o) {
     write_file_atomically(o.json, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
     std::cout << "wrote " << o.json << "\n";
   }
-  return 0;
+  if (skipped) {
+    std::cout << skipped << " files skipped:\n";
+    for (const auto& s : sets)
+      for (const auto& [file, why] : s.skipped) std::cout << "  " << why << "\n";
+  }
+  return skipped ? 1 : 0;  // the table holds the rest; the exit code says some input was bad
 }
 
 }  // namespace
@@ -205,10 +245,11 @@ void add_eval_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--split", o.split,
                   "only the files listed under this key of <folder>/manifest.json (e.g. test)");
   cmd->add_option("--json", o.json, "also write the results (table and per-sequence counts) to this JSON file");
-  cmd->add_option("--threads", o.threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--mano-left", o.mano_left, "left hand model .npz to pose the hands with (default: the shipped hand)");
   cmd->add_option("--mano-right", o.mano_right, "right hand model .npz (give both; e.g. converted MANO for ARCTIC data)");
-  cmd->add_flag("--quiet", o.quiet, "no progress bar");
+  cmd->add_flag("--keep-going", o.keep_going,
+                "skip files that fail (listed at the end and in the JSON) and evaluate the rest; exit code 1 "
+                "when any was skipped");
   out.push_back({cmd, [] { return eval(o); }, false});
 }
 

@@ -10,6 +10,7 @@
 #include "core/hand/procedural_hand.h"
 #include "core/render/rasterizer.h"
 #include "core/util/error.h"
+#include "core/util/output_path.h"
 
 namespace bimart::cli {
 
@@ -41,20 +42,27 @@ int make(const std::string& which, const std::string& out_dir, const std::string
   std::vector<HandSide> sides;
   if (which == "right" || which == "both") sides.push_back(HandSide::Right);
   if (which == "left" || which == "both") sides.push_back(HandSide::Left);
+  // Every output is checked, and the picture drawn, before the first file is written.
+  std::vector<std::string> paths;
+  for (HandSide side : sides)
+    paths.push_back(
+        (std::filesystem::path(out_dir) / (side == HandSide::Right ? "mano_right.npz" : "mano_left.npz")).string());
+  for (const std::string& p : paths) check_output_file(p);
+  if (!picture.empty()) check_output_file(picture);
+  std::vector<HandModel> models;
   std::vector<Image> images;
   for (HandSide side : sides) {
-    const HandModel m = make_procedural_hand(side);
-    const std::string path =
-        (std::filesystem::path(out_dir) / (side == HandSide::Right ? "mano_right.npz" : "mano_left.npz")).string();
-    save_hand_model(m, path);
-    std::cout << fmt::format("wrote {} ({} vertices, {} faces)\n", path, m.num_vertices(), m.num_faces());
+    models.push_back(make_procedural_hand(side));
     if (!picture.empty())
-      for (Image& im : pictures(m, 420)) images.push_back(std::move(im));
+      for (Image& im : pictures(models.back(), 420)) images.push_back(std::move(im));
   }
-  if (!picture.empty()) {
-    tile(images, 2).save_png(picture);
-    std::cout << "wrote " << picture << "\n";
+  if (!picture.empty()) tile(images, 2).save_png(picture);
+  for (size_t i = 0; i < models.size(); ++i) {
+    save_hand_model(models[i], paths[i]);
+    std::cout << fmt::format("wrote {} ({} vertices, {} faces)\n", paths[i], models[i].num_vertices(),
+                             models[i].num_faces());
   }
+  if (!picture.empty()) std::cout << "wrote " << picture << "\n";
   return 0;
 }
 

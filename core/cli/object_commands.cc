@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "core/cli/command.h"
+#include "core/cli/common_options.h"
 #include "core/object/families/families.h"
 #include "core/object/mesh_repair.h"
 #include "core/object/object_io.h"
@@ -95,7 +96,7 @@ void add_object_commands(CLI::App& app, Commands& out) {
   static std::uint64_t seed = 0;
   CLI::App* make_cmd = object->add_subcommand("make", "write a procedural object (top.obj, bottom.obj, object.yaml)");
   make_cmd->add_option("--category", category, "one of: " + join(object_categories(), ", "))->required();
-  make_cmd->add_option("--seed", seed, "random seed for the dimensions");
+  add_seed_option(make_cmd, seed, "random seed for the dimensions (default 0)");
   make_cmd->add_option("--out", dir, "output folder")->required();
   out.push_back({make_cmd, [] { return make(category, seed, dir); }, false});
 

@@ -1,6 +1,7 @@
 #include "core/cli/pipeline_commands.h"
 
 #include "core/cli/command.h"
+#include "core/cli/common_options.h"
 
 #include <fmt/format.h>
 
@@ -23,7 +24,7 @@ namespace {
 Graph load_graph(const PipelineArgs& args) {
   GraphFile file = GraphFile::load(args.pipeline);
   for (const auto& o : args.overrides) file.apply_override(o);
-  if (args.seed >= 0) file.seed = static_cast<std::uint64_t>(args.seed);
+  if (args.has_seed) file.seed = args.seed;
   for (const auto& [lib, where] : file.plugins) {
     try {
       PluginLoader::global().load(lib);
@@ -147,7 +148,7 @@ void add_pipeline_commands(CLI::App& app, Commands& out) {
   auto add_pipeline_args = [&](CLI::App* cmd) {
     cmd->add_option("pipeline", pa.pipeline, "pipeline YAML file")->required()->check(CLI::ExistingFile);
     cmd->add_option("--set", pa.overrides, "override a parameter: stage.param=value (repeatable)");
-    cmd->add_option("--seed", pa.seed, "override the pipeline's seed")->check(CLI::NonNegativeNumber);
+    add_seed_option(cmd, pa.seed, "override the pipeline's seed")->each([](const std::string&) { pa.has_seed = true; });
   };
 
   CLI::App* run_cmd = app.add_subcommand("run", "run a pipeline");

@@ -2,6 +2,7 @@
 // the process exit code.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -10,7 +11,8 @@ namespace bimart::cli {
 struct PipelineArgs {
   std::string pipeline;
   std::vector<std::string> overrides;  // stage.param=value
-  long long seed = -1;                 // < 0: the pipeline's own
+  std::uint64_t seed = 0;              // with has_seed; else the pipeline's own
+  bool has_seed = false;
 };
 
 int run(const PipelineArgs& args);

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/cli/command.h"
+#include "core/cli/common_options.h"
 #include "core/cli/sequence_files.h"
 #include "core/features/hand_features.h"
 #include "core/io/sequence.h"
@@ -31,6 +32,7 @@
 #include "core/util/atomic_file.h"
 #include "core/util/data_path.h"
 #include "core/util/error.h"
+#include "core/util/output_path.h"
 #include "core/util/log.h"
 #include "core/util/parallel.h"
 #include "core/util/progress.h"
@@ -44,7 +46,7 @@ struct RefineCliOptions {
   std::string folder, split, out = "out/refine", keypoints = "corrupted", json, mano_left, mano_right;
   std::uint64_t seed = 1;
   int limit = 0, threads = 0;
-  bool quiet = false, no_write = false;
+  bool no_write = false;
   RefineOptions refine;
   ManoFitOptions fit;
   KeypointCorruption corruption;
@@ -82,7 +84,7 @@ void write_result(const Sequence& in, const std::string& in_path, const HandMoti
 PerSequence process(const RefineCliOptions& o, const std::array<const HandModel*, 2>& models, ObjectCache& objects,
                     const std::string& file, std::uint64_t seed) {
   const Sequence s = read_sequence(file);
-  const auto entry = objects.get(resolve_object_path(s, file));
+  const auto entry = sequence_object(objects, s, file);
   const ArticulatedObject& object = entry->object;
   const ObjectDistance& distance = *entry->distance;
   PerSequence r;
@@ -148,6 +150,10 @@ int refine(RefineCliOptions o) {
   o.fit.validate();
   o.corruption.validate();
   std::vector<std::string> files = sequence_files(o.folder, o.split);
+  // Outputs first: a folder that cannot be written fails now, not after the work.
+  if (!o.no_write)
+    for (const char* sub : {"fit", "refined"}) check_output_folder((fs::path(o.out) / sub).string());
+  if (!o.json.empty()) check_output_file(o.json);
   if (o.limit > 0 && static_cast<size_t>(o.limit) < files.size()) files.resize(static_cast<size_t>(o.limit));
   const int threads = resolve_threads(o.threads);
   runtime::set_threads(1);  // one sequence per thread
@@ -161,12 +167,12 @@ int refine(RefineCliOptions o) {
   std::vector<PerSequence> results(files.size());
   const auto t0 = std::chrono::steady_clock::now();
   {
-    ProgressBar bar("refining", files.size(), !o.quiet);
+    ProgressBar bar("refining", files.size(), true);
     parallel_for(files.size(), threads, [&](size_t i) {
       try {
         results[i] = process(o, models, objects, files[i], o.seed * 1000003u + i);
       } catch (const Error& e) {
-        throw Error(files[i] + ": " + e.message());
+        throw in_sequence_file(files[i], e);
       }
       bar.step();
     });
@@ -244,9 +250,8 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--out", o.out, "folder for the results: <out>/fit/*.npz and <out>/refined/*.npz")->capture_default_str();
   cmd->add_flag("--no-write", o.no_write, "do not write the sequences");
   cmd->add_option("--limit", o.limit, "only the first N sequences")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--seed", o.seed, "corruption seed")->capture_default_str();
+  add_seed_option(cmd, o.seed, "corruption seed (default 1)");
   cmd->add_option("--json", o.json, "also write the table to this JSON file");
-  cmd->add_option("--threads", o.threads, "sequences in parallel (default: all cores)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--w-proj", o.refine.w_proj, "refinement: projection weight")->capture_default_str();
   cmd->add_option("--w-pen", o.refine.w_pen, "refinement: penetration weight (grows while too deep)")->capture_default_str();
   cmd->add_option("--w-acc", o.refine.w_acc, "refinement: acceleration weight")->capture_default_str();
@@ -257,7 +262,6 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--jitter", o.corruption.jitter, "corruption: RMS per-frame hand offset (m)")->capture_default_str();
   cmd->add_option("--mano-left", o.mano_left, "left hand model .npz (default: the shipped hand)");
   cmd->add_option("--mano-right", o.mano_right, "right hand model .npz (give both)");
-  cmd->add_flag("--quiet", o.quiet, "no progress bar");
   out.push_back({cmd, [] { return refine(o); }, false});
 }
 

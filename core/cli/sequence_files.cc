@@ -42,4 +42,20 @@ std::vector<std::string> sequence_files(const std::string& folder, const std::st
   return files;
 }
 
+Error in_sequence_file(const std::string& file, const Error& e) {
+  const std::string m = e.what();
+  if (m.compare(0, file.size(), file) == 0) return e;
+  return Error(file + ": " + m);
+}
+
+std::shared_ptr<const ObjectCache::Entry> sequence_object(ObjectCache& cache, const Sequence& s,
+                                                          const std::string& file) {
+  const std::string path = resolve_object_path(s, file);
+  try {
+    return cache.get(path);
+  } catch (const Error& e) {
+    throw Error(file + ": its object '" + s.object + "' (" + path + "): " + e.what());
+  }
+}
+
 }  // namespace bimart::cli

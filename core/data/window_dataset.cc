@@ -105,7 +105,11 @@ const HandInfo& hand_info() {
     for (int h = 0; h < 2; ++h) {
       const std::string& path = files[h];
       const HandModel model = load_hand_model(path);
-      ids[h] = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
+      try {
+        ids[h] = model_keypoints(model);
+      } catch (const Error& e) {
+        throw Error(path + ": " + e.message());
+      }
       std::error_code ec;
       f.add(fs::absolute(path).string());
       f.add_value(static_cast<std::uint64_t>(fs::file_size(path, ec)));

@@ -11,53 +11,6 @@
 
 namespace bimart {
 
-namespace {
-
-double unit_interval(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-}  // namespace
-
-BpsBasis make_bps_basis(int count, double radius, std::uint64_t seed) {
-  if (count <= 0 || !(radius > 0)) throw Error("a BPS basis needs count > 0 and radius > 0");
-  std::mt19937_64 rng(seed);
-  BpsBasis b{Points3(count, 3), radius, seed};
-  for (int i = 0; i < count;) {
-    const Eigen::Vector3d p(2 * unit_interval(rng) - 1, 2 * unit_interval(rng) - 1, 2 * unit_interval(rng) - 1);
-    if (p.squaredNorm() <= 1.0) b.points.row(i++) = radius * p.transpose();
-  }
-  return b;
-}
-
-BpsBasis load_bps_basis(const std::string& path) {
-  const NpzFile f = NpzFile::read(path);
-  BpsBasis b;
-  const Eigen::MatrixXd pts = to_eigen(f.get("points", {-1, 3}), f.where("points"));
-  b.points = pts;
-  b.radius = f.vector<double>("radius").at(0);
-  b.seed = f.vector<std::uint64_t>("seed").at(0);
-  if (b.points.rows() == 0) throw Error(path + ": the BPS basis is empty");
-  return b;
-}
-
-void save_bps_basis(const BpsBasis& basis, const std::string& path) {
-  NpzFile f;
-  f.set("points", make_npy(basis.points));
-  f.set("radius", make_npy_scalar(basis.radius));
-  f.set("seed", make_npy_scalar(basis.seed));
-  f.write(path);
-}
-
-const char* default_basis_file(BpsVariant variant) {
-  switch (variant) {
-    case BpsVariant::Uniform: return "models/bps/u_bps_1024_r0.5.npz";
-    case BpsVariant::PartAgnostic: return "models/bps/npa_bps_1024.npz";
-    case BpsVariant::PerPart: return "models/bps/np_bps_512.npz";
-  }
-  return "";
-}
-
-int basis_size(BpsVariant variant) { return variant == BpsVariant::PerPart ? 512 : 1024; }
-
 ObjectEncoding encode_object(const ArticulatedObject& object, const at::Tensor& states,
                              const BpsBasis& basis, BpsVariant variant) {
   if (states.dim() != 2 || states.size(1) != 7)

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry/point_guard.h"
 #include "core/util/error.h"
 
 namespace bimart {
@@ -116,7 +117,7 @@ MeshDistance::MeshDistance(const TriangleMesh& input) : impl_(std::make_unique<I
   points.reserve(static_cast<size_t>(input.num_vertices()));
   for (Eigen::Index i = 0; i < input.num_vertices(); ++i) {
     const auto v = input.vertices.row(i);
-    if (!v.allFinite()) throw Error("MeshDistance: vertex " + std::to_string(i) + " is not finite");
+    check_point(v.transpose(), "MeshDistance: mesh vertex", i);
     points.emplace_back(v(0), v(1), v(2));
   }
   std::vector<std::array<std::size_t, 3>> polygons;
@@ -179,6 +180,7 @@ double depth_inside(const Comps& comps, const Point& q, const void** deepest) {
 }  // namespace
 
 SurfaceQuery MeshDistance::query(const Eigen::Vector3d& p) const {
+  check_point(p, "surface query");
   const Point q(p.x(), p.y(), p.z());
   const auto hit = impl_->tree.closest_point_and_primitive(q);
   SurfaceQuery out;
@@ -215,12 +217,14 @@ SurfaceQuery MeshDistance::query(const Eigen::Vector3d& p) const {
 Eigen::AlignedBox3d MeshDistance::bounding_box() const { return Eigen::AlignedBox3d(impl_->lo, impl_->hi); }
 
 double MeshDistance::signed_distance(const Eigen::Vector3d& p) const {
+  check_point(p, "signed distance");
   const Point q(p.x(), p.y(), p.z());
   const double depth = depth_inside(impl_->components, q, nullptr);
   return depth >= 0 ? depth : -std::sqrt(impl_->tree.squared_distance(q));
 }
 
 bool MeshDistance::inside(const Eigen::Vector3d& p) const {
+  check_point(p, "inside test");
   const Point q(p.x(), p.y(), p.z());
   for (const auto& c : impl_->components)
     if ((*c->side)(q) == CGAL::ON_BOUNDED_SIDE) return true;
@@ -228,6 +232,7 @@ bool MeshDistance::inside(const Eigen::Vector3d& p) const {
 }
 
 double MeshDistance::max_signed_distance(const Points3& points) const {
+  check_points(points, "signed distance");
   double best = -std::numeric_limits<double>::infinity();
   const Eigen::Vector3d lo = impl_->lo, hi = impl_->hi;
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
@@ -256,6 +261,7 @@ double MeshDistance::max_signed_distance(const Points3& points) const {
 }
 
 bool MeshDistance::any_deeper_than(const Points3& points, double threshold) const {
+  check_points(points, "depth test");
   const Eigen::Vector3d lo = impl_->lo, hi = impl_->hi;
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d p = points.row(i).transpose();

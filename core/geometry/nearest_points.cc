@@ -2,6 +2,7 @@
 
 #include <nanoflann.hpp>
 
+#include "core/geometry/point_guard.h"
 #include "core/util/error.h"
 
 namespace bimart {
@@ -27,6 +28,7 @@ struct NearestPoints::Tree {
 
 NearestPoints::NearestPoints(Points3 points) {
   if (points.rows() == 0) throw Error("nearest-point search needs at least one point");
+  check_points(points, "nearest-point search");
   tree_ = std::make_unique<Tree>(std::move(points));
 }
 
@@ -37,6 +39,7 @@ NearestPoints& NearestPoints::operator=(NearestPoints&&) noexcept = default;
 const Points3& NearestPoints::points() const { return tree_->cloud.pts; }
 
 NearestPoints::Hit NearestPoints::nearest(const Eigen::Vector3d& q) const {
+  check_point(q, "nearest-point query");
   std::uint32_t index = 0;
   double d2 = 0;
   const double query[3] = {q.x(), q.y(), q.z()};
@@ -45,6 +48,7 @@ NearestPoints::Hit NearestPoints::nearest(const Eigen::Vector3d& q) const {
 }
 
 void NearestPoints::nearest(const Points3& queries, int* indices, double* distances_sq) const {
+  check_points(queries, "nearest-point query");
   for (Eigen::Index i = 0; i < queries.rows(); ++i) {
     std::uint32_t index = 0;
     double d2 = 0;

@@ -98,4 +98,12 @@ std::vector<int> hand_keypoints(const HandModel& model, int J) {
   return out;
 }
 
+std::vector<int> model_keypoints(const HandModel& model) {
+  std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model, kNumKeypoints) : model.keypoints;
+  if (static_cast<int>(ids.size()) != kNumKeypoints)
+    throw Error("hand model has " + std::to_string(ids.size()) + " keypoints ('keypoint_verts'), expected " +
+                std::to_string(kNumKeypoints));
+  return ids;
+}
+
 }  // namespace bimart

@@ -16,6 +16,14 @@ namespace bimart {
 // Throws bimart::Error if J is smaller than 2 per non-empty part or larger than V.
 std::vector<int> hand_keypoints(const HandModel& model, int J = 100);
 
+// J of the hand representation (DESIGN §4).
+constexpr int kNumKeypoints = 100;
+
+// The keypoint ids every command uses, one rule for all: the model's stored
+// `keypoint_verts`, else computed with hand_keypoints; exactly kNumKeypoints of them, else a
+// bimart::Error.
+std::vector<int> model_keypoints(const HandModel& model);
+
 // The part (joint id) of every vertex: the argmax of its skinning weights, lowest on ties.
 std::vector<int> hand_parts(const HandModel& model);
 

@@ -1,11 +1,14 @@
 #include "core/io/npz.h"
 
+#include <fmt/format.h>
 #include <zip.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -20,6 +23,7 @@ constexpr char kMagic[] = "\x93NUMPY";
 constexpr size_t kMagicSize = 6;
 constexpr size_t kHeaderAlign = 64;  // numpy >= 1.15 pads the header to 64 bytes
 constexpr int64_t kMaxElements = int64_t{1} << 48;
+constexpr zip_uint64_t kMaxInflation = 1032;  // deflate's largest expansion ratio
 
 // Bytes per element of a supported dtype code; 0 for an unknown one.
 int dtype_size(const std::string& d) {
@@ -388,6 +392,8 @@ NpzFile NpzFile::read(const std::string& path) {
 
   NpzFile npz;
   npz.path_ = path;
+  std::error_code size_error;
+  const zip_uint64_t archive_size = std::filesystem::file_size(path, size_error);
   const zip_int64_t n = zip_get_num_entries(za, 0);
   for (zip_int64_t i = 0; i < n; ++i) {
     zip_stat_t st;
@@ -401,15 +407,34 @@ NpzFile NpzFile::read(const std::string& path) {
     const std::string what = npz.where(key);
     std::unique_ptr<zip_file_t, decltype(&zip_fclose)> f(zip_fopen_index(za, i, 0), &zip_fclose);
     if (!f) throw Error(what + ": cannot open: " + zip_strerror(za));
-    std::vector<uint8_t> bytes(st.size);
+    // The sizes in the archive's directory are claims: a damaged 1 KB file may declare a
+    // 4 GB member. Bound them by what the file's bytes can hold (deflate expands at most
+    // 1032:1), and grow the buffer as data arrives rather than trusting the claim.
+    const zip_uint64_t comp = (st.valid & ZIP_STAT_COMP_SIZE) ? st.comp_size : archive_size;
+    if (comp > archive_size || st.size > kMaxInflation * comp + 1024)
+      throw Error(fmt::format("{}: the archive declares {} bytes ({} compressed) for this member, more than its {} "
+                              "bytes can hold; the file is damaged",
+                              what, st.size, comp, archive_size));
+    std::vector<uint8_t> bytes;
     zip_uint64_t got = 0;
     while (got < st.size) {
-      const zip_int64_t r = zip_fread(f.get(), bytes.data() + got, st.size - got);
+      const zip_uint64_t chunk = std::min<zip_uint64_t>(st.size - got, zip_uint64_t{1} << 24);
+      bytes.resize(static_cast<size_t>(got + chunk));
+      const zip_int64_t r = zip_fread(f.get(), bytes.data() + got, chunk);
       if (r < 0) throw Error(what + ": corrupt data: " + zip_file_strerror(f.get()));
       if (r == 0) break;
       got += static_cast<zip_uint64_t>(r);
     }
+    bytes.resize(static_cast<size_t>(got));
     if (got != st.size) throw Error(what + ": truncated member");
+    // libzip checks the CRC only when a read reaches the end of the member, which reading
+    // exactly st.size bytes never does; numpy checks it, so do we.
+    if (st.valid & ZIP_STAT_CRC) {
+      const uLong crc = crc32_z(crc32_z(0L, Z_NULL, 0), bytes.data(), bytes.size());
+      if (crc != st.crc)
+        throw Error(fmt::format("{}: corrupt member (CRC-32 {:08x}, the archive says {:08x}); the file is damaged",
+                                what, crc, st.crc));
+    }
     npz.arrays_[key] = parse_npy(bytes.data(), bytes.size(), what);
   }
   return npz;

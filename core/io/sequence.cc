@@ -1,11 +1,14 @@
 #include "core/io/sequence.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <filesystem>
 #include <vector>
 
 #include <ATen/ATen.h>
 
+#include "core/geometry/point_guard.h"
 #include "core/io/npz.h"
 #include "core/util/error.h"
 
@@ -20,8 +23,29 @@ constexpr int kFormatVersion = 1;
 // A float32 contiguous CPU copy (callers may hand in doubles or views).
 at::Tensor as_f32(const at::Tensor& t) { return t.detach().to(at::kCPU, at::kFloat).contiguous(); }
 
+// Where element `flat` of a tensor sits, e.g. "frame 3 [0]" or "left hand, frame 3 [5, 2]";
+// `frame_dim` is the axis of the frames (-1: none).
+std::string element_place(const at::Tensor& t, int64_t flat, int frame_dim) {
+  std::vector<int64_t> idx(static_cast<size_t>(t.dim()));
+  for (int64_t d = t.dim() - 1; d >= 0; --d) {
+    idx[static_cast<size_t>(d)] = flat % t.size(d);
+    flat /= t.size(d);
+  }
+  std::string place, rest;
+  for (int64_t d = 0; d < t.dim(); ++d) {
+    const int64_t i = idx[static_cast<size_t>(d)];
+    if (d == frame_dim) place += (place.empty() ? "" : ", ") + ("frame " + std::to_string(i));
+    else if (frame_dim == 1 && d == 0) place += i == 0 ? "left hand" : "right hand";
+    else rest += (rest.empty() ? "" : ", ") + std::to_string(i);
+  }
+  return place + (rest.empty() ? "" : " [" + rest + "]");
+}
+
+// Shape, then every value finite and within `bound` (DESIGN §8: a clear error naming the
+// field, frame and component, never a crash further down). bound <= 0: finite only.
 void check_tensor(const at::Tensor& t, const std::string& field, const std::vector<int64_t>& shape,
-                  const std::string& where) {
+                  const std::string& where, double bound = kMaxPoseValue, const char* unit = "",
+                  int frame_dim = 0) {
   const std::string at_ = where.empty() ? "" : where + ": ";
   if (!t.defined()) throw Error(at_ + "sequence field '" + field + "' is missing");
   bool ok = t.dim() == static_cast<int64_t>(shape.size());
@@ -36,8 +60,18 @@ void check_tensor(const at::Tensor& t, const std::string& field, const std::vect
     got += "]";
     throw Error(at_ + "sequence field '" + field + "' has shape " + got + ", expected " + want);
   }
-  if (t.numel() > 0 && !at::isfinite(t.to(at::kDouble)).all().item<bool>())
-    throw Error(at_ + "sequence field '" + field + "' has a value that is not finite");
+  if (t.numel() == 0) return;
+  const at::Tensor d = t.detach().to(at::kCPU, at::kDouble).contiguous();
+  const double* v = d.data_ptr<double>();
+  const long bad = first_out_of_bounds(v, static_cast<long>(d.numel()), bound > 0 ? bound : HUGE_VAL);
+  if (bad < 0) return;
+  const std::string place = element_place(d, bad, shape.size() == 1 ? -1 : frame_dim);
+  if (!std::isfinite(v[bad]))
+    throw Error(at_ + "sequence field '" + field + "', " + place + ": value " + fmt::format("{}", v[bad]) +
+                " is not finite");
+  throw Error(at_ + "sequence field '" + field + "', " + place + ": value " + fmt::format("{:g}", v[bad]) +
+              " is beyond the bound ±" + fmt::format("{:g}", bound) + unit +
+              " (docs/formats.md, \"Sequence\")");
 }
 
 void validate_at(const Sequence& s, const std::string& where) {
@@ -45,23 +79,27 @@ void validate_at(const Sequence& s, const std::string& where) {
   if (!(std::isfinite(s.fps) && s.fps > 0))
     throw Error(at_ + "sequence field 'fps' must be a positive number, got " + std::to_string(s.fps));
   if (s.object.empty()) throw Error(at_ + "sequence field 'object' (the object path) is empty");
-  check_tensor(s.object_states, "object_states", {-1, 7}, where);
+  check_tensor(s.object_states, "object_states", {-1, 7}, where, kMaxPoseValue, " (rad or m)");
   const int64_t n = s.object_states.size(0);
   if (n < 1) throw Error(at_ + "sequence has no frames ('object_states' is empty)");
+  if (n > kMaxFrames)
+    throw Error(at_ + "sequence has " + std::to_string(n) + " frames, more than the " + std::to_string(kMaxFrames) +
+                " bimart handles");
   for (int h = 0; h < 2; ++h) {
     const std::string p = kHandPrefix[h];
     const HandParams& hp = s.hands.hands[static_cast<size_t>(h)];
-    check_tensor(hp.rot, p + "rot", {n, 3}, where);
-    check_tensor(hp.pose, p + "pose", {n, 45}, where);
-    check_tensor(hp.trans, p + "trans", {n, 3}, where);
-    check_tensor(hp.shape, p + "shape", {10}, where);
+    check_tensor(hp.rot, p + "rot", {n, 3}, where, kMaxPoseValue, " rad");
+    check_tensor(hp.pose, p + "pose", {n, 45}, where, kMaxPoseValue, " rad");
+    check_tensor(hp.trans, p + "trans", {n, 3}, where, kMaxPoseValue, " m");
+    check_tensor(hp.shape, p + "shape", {10}, where, kMaxPoseValue);
   }
-  if (s.hands.has_vertices()) check_tensor(s.hands.vertices, "hand_vertices", {2, n, -1, 3}, where);
+  if (s.hands.has_vertices())
+    check_tensor(s.hands.vertices, "hand_vertices", {2, n, -1, 3}, where, kMaxPoseValue, " m", 1);
   if (s.contact_maps.defined() != s.basis_hit_indices.defined())
     throw Error(at_ + "sequence fields 'contact_maps' and 'basis_hit_indices' come together");
   if (s.contact_maps.defined()) {
-    check_tensor(s.contact_maps, "contact_maps", {n, 2, -1}, where);
-    check_tensor(s.basis_hit_indices, "basis_hit_indices", {n, s.contact_maps.size(2)}, where);
+    check_tensor(s.contact_maps, "contact_maps", {n, 2, -1}, where, kMaxPoseValue, " m");
+    check_tensor(s.basis_hit_indices, "basis_hit_indices", {n, s.contact_maps.size(2)}, where, 0);
   }
 }
 

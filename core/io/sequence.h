@@ -13,6 +13,10 @@
 
 namespace bimart {
 
+// The longest sequence anything reads or makes: 10^6 frames (9 h at 30 fps). Longer
+// requests are refused up front instead of failing in an allocator.
+constexpr std::int64_t kMaxFrames = 1000000;
+
 struct Sequence {
   std::string name;      // e.g. "laptop_s0003_use_012"
   // Where the object lives: a path to an object folder or YAML (core/object/object_io.h),

@@ -1,14 +1,36 @@
 #include "core/metrics/frame_depths.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <limits>
 #include <string>
 
 #include <ATen/ATen.h>
 
+#include "core/geometry/point_guard.h"
 #include "core/util/error.h"
 
 namespace bimart {
+namespace {
+
+// Diverged motion (NaN, or absurdly far) is reported with its frame, hand and vertex
+// before any of it reaches CGAL.
+void check_frame_points(const Points3& pts, int64_t v, int64_t t) {
+  for (Eigen::Index i = 0; i < pts.rows(); ++i) {
+    const Eigen::Vector3d p = pts.row(i).transpose();
+    if (p.allFinite() && p.cwiseAbs().maxCoeff() <= kMaxCoordinate) continue;
+    const char* side = i < v ? "left" : "right";
+    throw Error(fmt::format("frame {}: {} hand vertex {} is ({:.6g}, {:.6g}, {:.6g}): {} (field 'hand_vertices', or "
+                            "posed from '{}_rot', '{}_pose', '{}_trans', '{}_shape')",
+                            t, side, i % v, p.x(), p.y(), p.z(),
+                            p.allFinite() ? fmt::format("more than {:g} m from the origin", kMaxCoordinate)
+                                          : std::string("not finite"),
+                            side, side, side, side));
+  }
+}
+
+}  // namespace
 
 FrameDepths frame_depths(const ObjectDistance& distance, const at::Tensor& states_in,
                          const at::Tensor& vertices_in) {
@@ -31,6 +53,7 @@ FrameDepths frame_depths(const ObjectDistance& distance, const at::Tensor& state
     for (int h = 0; h < 2; ++h)
       std::copy_n(x + ((h * n + t) * v) * 3, v * 3, pts.data() + h * v * 3);
     if (v == 0) continue;
+    check_frame_points(pts, v, t);
     out.top[static_cast<size_t>(t)] = distance.max_signed_distance(state, pts, ObjectPart::Top);
     out.bottom[static_cast<size_t>(t)] = distance.max_signed_distance(state, pts, ObjectPart::Bottom);
   }

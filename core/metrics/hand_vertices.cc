@@ -7,6 +7,11 @@
 
 #include <ATen/ATen.h>
 
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/geometry/point_guard.h"
 #include "core/hand/hand_model.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs_torch.h"
@@ -29,10 +34,30 @@ std::shared_ptr<const PosingHands> load_posing_hands(const std::array<std::strin
   for (int h = 0; h < 2; ++h) {
     const HandModel& model = models[static_cast<size_t>(h)];
     hands->tensors[h] = HandModelTensors::from(model, at::kFloat);
-    const std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model) : model.keypoints;
+    std::vector<int> ids;
+    try {
+      ids = model_keypoints(model);  // the same rule as every command
+    } catch (const Error& e) {
+      throw Error(files[static_cast<size_t>(h)] + ": " + e.message());
+    }
     hands->keypoints[h].assign(ids.begin(), ids.end());
   }
   return hands;
+}
+
+// Posing refuses parameters beyond the documented bounds (core/geometry/point_guard.h):
+// LBS of a rotation of 1e30 rad gives NaN vertices.
+void check_pose_values(const at::Tensor& t, const std::string& field) {
+  const at::Tensor d = t.detach().to(at::kCPU, at::kDouble).contiguous();
+  const long bad = first_out_of_bounds(d.data_ptr<double>(), static_cast<long>(d.numel()), kMaxPoseValue);
+  if (bad < 0) return;
+  const int64_t per_frame = d.dim() >= 2 ? d.numel() / d.size(0) : d.numel();
+  throw Error(fmt::format("field '{}'{}: value {:g} is {}", field,
+                          d.dim() >= 2 ? fmt::format(", frame {} [{}]", bad / per_frame, bad % per_frame)
+                                       : fmt::format(" [{}]", bad),
+                          d.data_ptr<double>()[bad],
+                          std::isfinite(d.data_ptr<double>()[bad]) ? fmt::format("beyond the bound ±{:g}", kMaxPoseValue)
+                                                                   : std::string("not finite")));
 }
 
 std::mutex posing_mutex;
@@ -65,6 +90,12 @@ at::Tensor hand_vertices(const HandMotion& motion) {
     const at::Tensor& v = motion.vertices;
     if (v.dim() != 4 || v.size(0) != 2 || v.size(1) != n || v.size(3) != 3)
       throw Error("hand vertices must be [2, N, V, 3] with N = " + std::to_string(n) + " frames");
+    // The same hands as the model poses: keypoints and contact maps index into them.
+    const std::shared_ptr<const PosingHands> models = posing_hands();
+    const int64_t expected = models->tensors[0].v_template.size(0);
+    if (v.size(2) != expected)
+      throw Error("field 'hand_vertices' has " + std::to_string(v.size(2)) + " vertices per hand, but the hand model (" +
+                  models->files[0] + ") has " + std::to_string(expected));
     return v.to(at::kCPU, at::kFloat).contiguous();
   }
   if (n < 1) throw Error("hand motion has no frames");
@@ -73,6 +104,11 @@ at::Tensor hand_vertices(const HandMotion& motion) {
   at::NoGradGuard no_grad;
   for (int h = 0; h < 2; ++h) {
     const HandParams& p = motion.hands[static_cast<size_t>(h)];
+    const std::string side = h == 0 ? "left_" : "right_";
+    check_pose_values(p.rot, side + "rot");
+    check_pose_values(p.pose, side + "pose");
+    check_pose_values(p.trans, side + "trans");
+    check_pose_values(p.shape, side + "shape");
     auto f = [](const at::Tensor& t) { return t.detach().to(at::kCPU, at::kFloat).contiguous(); };
     const at::Tensor betas = f(p.shape).reshape({1, -1}).expand({n, -1}).contiguous();
     per_hand.push_back(lbs(models->tensors[h], f(p.rot), f(p.pose), f(p.trans), betas).vertices);

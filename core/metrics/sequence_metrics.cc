@@ -8,6 +8,7 @@
 #include "core/metrics/contact_map_error.h"
 #include "core/metrics/frame_depths.h"
 #include "core/metrics/penetration.h"
+#include "core/util/error.h"
 
 namespace bimart {
 
@@ -16,8 +17,13 @@ SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectD
   SequenceMetrics m;
   m.name = d.name;
   m.frames = d.object_states.size(0);
+  FrameDepths depths;
+  try {
+    depths = frame_depths(distance, d.object_states, d.hand_vertices);
+  } catch (const Error& e) {
+    throw Error((d.name.empty() ? std::string() : "sequence '" + d.name + "', ") + e.message());
+  }
   m.accel = mean_acceleration(d.hand_vertices);
-  const FrameDepths depths = frame_depths(distance, d.object_states, d.hand_vertices);
   m.pen_1cm = penetration_frames(depths, kPenetration1cm);
   m.pen_5mm = penetration_frames(depths, kPenetration5mm);
   m.contact = contact_frames(depths, object_moving_frames(object, d.object_states));

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <vector>
 
+#include "core/object/mesh_file_check.h"
 #include "core/util/error.h"
 
 namespace bimart {
@@ -76,12 +77,12 @@ int orient_components_outward(TriangleMesh& m) {
 }  // namespace
 
 TriangleMesh read_mesh_file(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw Error(path + ": mesh file not found");
+  check_mesh_file(path);  // names the fault and the line; bounds what headers declare
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
   bool ok = false;
   try {
-    ok = CGAL::IO::read_polygon_soup(path, points, polygons);
+    ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
   } catch (const std::exception& e) {
     throw Error(path + ": cannot read mesh: " + e.what());
   }

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <ostream>
+#include <sstream>
 
 #include "core/geometry/rotation.h"
 #include "core/object/families/families.h"
@@ -16,6 +18,7 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/text.h"
+#include "core/util/yaml_keys.h"
 
 namespace bimart {
 
@@ -40,6 +43,26 @@ Eigen::Vector3d read_vec3(const std::string& file, const YAML::Node& n, const st
   return v;
 }
 
+// A closed part must enclose a volume and sit at the hinge; measured after closing.
+void check_part_shape(const TriangleMesh& m, const std::string& path) {
+  if (m.num_faces() < kMinPartFaces)
+    throw Error(fmt::format("{}: the part has {} faces once closed; a solid part needs at least {} (is it a single "
+                            "sheet or triangle?)",
+                            path, m.num_faces(), kMinPartFaces));
+  const double r = bounding_radius(m);
+  const double volume = signed_volume(m);
+  if (!(volume > kMinPartVolumeRatio * r * r * r))
+    throw Error(fmt::format("{}: the part encloses {:.3g} m³ once closed, about zero for its size (radius {:.3g} "
+                            "m): a flat or inside-out mesh is no solid part",
+                            path, volume, r));
+  const Eigen::Vector3d lo = m.vertices.colwise().minCoeff(), hi = m.vertices.colwise().maxCoeff();
+  const double gap = lo.cwiseMax(-hi).cwiseMax(0.0).norm();  // box to the hinge point (origin)
+  if (gap > kMaxHingeGapRatio * r + kMinPartRadius)
+    throw Error(fmt::format("{}: the part is {:.3g} m from the hinge (its nearest point; its radius is {:.3g} m): "
+                            "parts must touch the hinge; check hinge.pivot and units",
+                            path, gap, r));
+}
+
 // Reads, checks, scales to metres, moves to the canonical frame, closes and orients a part.
 TriangleMesh load_part(const std::string& path, double scale, const Eigen::Isometry3d& to_canonical,
                        RepairReport& report) {
@@ -55,6 +78,7 @@ TriangleMesh load_part(const std::string& path, double scale, const Eigen::Isome
     m.vertices.row(i) = (to_canonical * Eigen::Vector3d(m.vertices.row(i))).transpose();
   report = close_and_orient(m, path);
   if (report.changed()) log::info("{}: {}", path, report.str());
+  check_part_shape(m, path);
   return m;
 }
 
@@ -91,13 +115,20 @@ double metres_per_unit(const std::string& units) {
 
 ArticulatedObject load_object_yaml(const std::string& file, ObjectLoadReport* report) {
   YAML::Node root;
+  std::string source;
+  {
+    std::ifstream in(file);
+    if (!in) throw Error(file + ": cannot open the object file");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    source = ss.str();
+  }
   try {
-    root = YAML::LoadFile(file);
-  } catch (const YAML::BadFile&) {
-    throw Error(file + ": cannot open the object file");
+    root = YAML::Load(source);
   } catch (const YAML::ParserException& e) {
     throw Error(SourceLocation{file, e.mark.line + 1, e.mark.column + 1}, e.msg);
   }
+  check_duplicate_keys(source, file);
   if (!root.IsMap()) throw Error(file + ": expected a map with name, top, bottom");
   static const std::vector<std::string> known = {"name", "category", "top", "bottom", "units", "hinge", "limits",
                                                  "open_angle"};

@@ -51,5 +51,11 @@ double metres_per_unit(const std::string& units);
 // Parts outside [1 cm, 3 m] of bounding radius (half the box diagonal) are rejected.
 constexpr double kMinPartRadius = 0.01;
 constexpr double kMaxPartRadius = 3.0;
+// A part must be a solid at the hinge (checked after closing its holes): at least 4 faces
+// (a tetrahedron), a volume above this share of its radius cubed (zero up to rounding), and
+// its nearest point within this many radii (plus 1 cm) of the hinge point.
+constexpr int kMinPartFaces = 4;
+constexpr double kMinPartVolumeRatio = 1e-6;
+constexpr double kMaxHingeGapRatio = 2.0;
 
 }  // namespace bimart

@@ -1,8 +1,11 @@
 #include "core/object/object_state.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <string>
 
+#include "core/geometry/point_guard.h"
 #include "core/geometry/rotation.h"
 #include "core/util/error.h"
 
@@ -16,6 +19,9 @@ ObjectState state_from(const T* row) {
   for (int i = 0; i < 7; ++i)
     if (!std::isfinite(static_cast<double>(row[i])))
       throw Error(std::string("object state: ") + names[i] + " is not finite");
+    else if (std::abs(static_cast<double>(row[i])) > kMaxPoseValue)
+      throw Error(fmt::format("object state: {} = {:g} is beyond the bound ±{:g} (rad or m)", names[i],
+                              static_cast<double>(row[i]), kMaxPoseValue));
   ObjectState s;
   s.angle = row[0];
   s.root_rotation = Eigen::Vector3d(row[1], row[2], row[3]);

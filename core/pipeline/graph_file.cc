@@ -6,6 +6,7 @@
 
 #include "core/pipeline/graph.h"
 #include "core/util/text.h"
+#include "core/util/yaml_keys.h"
 
 namespace fs = std::filesystem;
 
@@ -94,6 +95,7 @@ GraphFile GraphFile::parse(const std::string& text, const std::string& path,
   } catch (const YAML::Exception& e) {
     throw Error(SourceLocation{path, e.mark.line + 1, e.mark.column + 1}, "YAML syntax: " + e.msg);
   }
+  check_duplicate_keys(text, path);
   const Reader r(path);
   if (!root.IsMap()) throw Error(SourceLocation{path, 1, 1}, "a pipeline must be a mapping with a 'stages' list");
   r.only_keys(root, {"name", "description", "seed", "plugins", "stages"}, "the pipeline");

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "core/geometry/rotation.h"
+#include "core/geometry/point_guard.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs_subset.h"
 #include "core/hand/lbs_torch.h"
@@ -216,13 +217,6 @@ void ManoFitOptions::validate() const {
   if (threads < 0) throw Error("mano fit: threads must be >= 0 (0 = all cores)");
 }
 
-std::vector<int> model_keypoints(const HandModel& model) {
-  std::vector<int> ids = model.keypoints.empty() ? hand_keypoints(model, kJ) : model.keypoints;
-  if (static_cast<int>(ids.size()) != kJ)
-    throw Error("hand model has " + std::to_string(ids.size()) + " keypoints, expected " +
-                std::to_string(kJ));
-  return ids;
-}
 
 HandMotion fit_mano(const std::array<const HandModel*, 2>& models, const at::Tensor& keypoints_world,
                     const ManoFitOptions& options, ManoFitReport* report) {
@@ -231,7 +225,8 @@ HandMotion fit_mano(const std::array<const HandModel*, 2>& models, const at::Ten
   if (H.dim() != 4 || H.size(0) != 2 || H.size(2) != kJ || H.size(3) != 3 || H.size(1) < 1)
     throw Error("mano fit: keypoints must be [2, N, 100, 3] with N >= 1, got " + std::string(c10::str(H.sizes())));
   const at::Tensor Hd = H.to(at::kCPU, at::kDouble).contiguous();
-  if (!at::isfinite(Hd).all().item<bool>()) throw Error("mano fit: keypoints hold values that are not finite");
+  if (first_out_of_bounds(Hd.data_ptr<double>(), static_cast<long>(Hd.numel()), kMaxCoordinate) >= 0)
+    throw Error("mano fit: keypoints hold values that are not finite or beyond 10 km (diverged input?)");
   const int64_t N = H.size(1);
   const auto t0 = std::chrono::steady_clock::now();
 

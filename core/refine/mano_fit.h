@@ -25,6 +25,7 @@
 #include <ATen/core/Tensor.h>
 
 #include "core/hand/hand_model.h"
+#include "core/hand/keypoints.h"  // model_keypoints
 #include "core/hand/hand_motion.h"
 
 namespace bimart {
@@ -67,7 +68,5 @@ inline at::Tensor pose_hand_vertices(const std::array<const HandModel*, 2>& mode
   return pose_hands(models, motion).vertices;
 }
 
-// The keypoint vertex ids of a model: its stored ones, else computed (core/hand/keypoints.h).
-std::vector<int> model_keypoints(const HandModel& model);
 
 }  // namespace bimart

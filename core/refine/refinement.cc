@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "core/features/hand_features.h"
+#include "core/geometry/point_guard.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs_subset.h"
 #include "core/refine/hand_state.h"
@@ -460,7 +461,8 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
   if (!states.defined() || states.dim() != 2 || states.size(0) != N || states.size(1) != 7)
     throw Error("refinement: object states must be [" + std::to_string(N) + ", 7]");
   const at::Tensor X = keypoints.to(at::kCPU, at::kDouble).contiguous();
-  if (!at::isfinite(X).all().item<bool>()) throw Error("refinement: keypoints hold values that are not finite");
+  if (first_out_of_bounds(X.data_ptr<double>(), static_cast<long>(X.numel()), kMaxCoordinate) >= 0)
+    throw Error("refinement: keypoints hold values that are not finite or beyond 10 km (diverged input?)");
   const auto t0 = std::chrono::steady_clock::now();
   const at::Tensor st = states.to(at::kCPU, at::kDouble).contiguous();
   const HandKeypointsWorld w = hand_features_to_world(X, st);

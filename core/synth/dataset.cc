@@ -20,6 +20,7 @@
 #include "core/render/rasterizer.h"
 #include "core/util/data_path.h"
 #include "core/util/error.h"
+#include "core/util/output_path.h"
 #include "core/util/log.h"
 #include "core/util/parallel.h"
 #include "core/util/progress.h"
@@ -62,7 +63,9 @@ struct SequenceJob {
 
 void prepare_folder(const SynthOptions& o) {
   if (o.out.empty()) throw Error("data synth: no output folder (--out)");
-  if (fs::exists(o.out) && !fs::is_directory(o.out)) throw Error(o.out + ": exists and is not a folder");
+  std::error_code ec;
+  if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) throw Error(o.out + ": exists and is not a folder");
+  check_output_folder(o.out);  // writable, before anything is removed or computed
   if (fs::exists(o.out) && !fs::is_empty(o.out)) {
     if (!o.force)
       throw Error(o.out + ": not empty; choose another folder or pass --force to replace the data set in it");
@@ -70,8 +73,8 @@ void prepare_folder(const SynthOptions& o) {
       throw Error(o.out + ": not a bimart data set (no manifest.json or sequences/); refusing to replace it");
     for (const char* sub : {"manifest.json", "sequences", "objects", "preview", "cache"}) fs::remove_all(fs::path(o.out) / sub);
   }
-  fs::create_directories(fs::path(o.out) / "sequences");
-  fs::create_directories(fs::path(o.out) / "objects");
+  check_output_folder((fs::path(o.out) / "sequences").string());
+  check_output_folder((fs::path(o.out) / "objects").string());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "core/geometry/mesh_distance.h"
 #include "core/hand/hand_model.h"
 #include "core/io/sequence.h"
+#include "core/util/error.h"
 #include "core/metrics/articulation.h"
 #include "core/metrics/contact.h"
 #include "core/metrics/frame_depths.h"
@@ -50,7 +51,12 @@ DatasetCheck check_dataset(const std::string& folder, const std::string& split, 
     parallel_for(files.size(), threads, [&](size_t i) {
       const Sequence s = read_sequence(files[i]);
       const std::string path = resolve_object_path(s, files[i]);
-      const auto obj = objects.get(path);
+      std::shared_ptr<const ObjectCache::Entry> obj;
+      try {
+        obj = objects.get(path);
+      } catch (const Error& e) {
+        throw Error(files[i] + ": its object '" + s.object + "' (" + path + "): " + e.what());
+      }
       DatasetCheck& c = parts[i];
       c.sequences = 1;
       const at::Tensor v = hand_vertices(s.hands).to(at::kDouble).contiguous();

@@ -2,10 +2,13 @@
 
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include "core/util/error.h"
+#include "core/util/interrupt.h"
 
 namespace fs = std::filesystem;
 
@@ -16,19 +19,23 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   std::error_code ec;
   if (target.has_parent_path()) {
     fs::create_directories(target.parent_path(), ec);
-    if (ec) throw Error("cannot create folder " + target.parent_path().string() + ": " + ec.message());
+    if (ec)
+      throw Error("cannot write " + path + ": cannot create folder " + target.parent_path().string() + ": " +
+                  ec.message());
   }
   const fs::path tmp = target.string() + ".tmp-" + std::to_string(::getpid());
+  const InterruptCleanup cleanup(tmp.string());
   try {
     {
+      errno = 0;
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      if (!out) throw Error("cannot write " + tmp.string());
+      if (!out) throw Error("cannot write " + path + ": " + (errno ? std::strerror(errno) : "cannot create a file there"));
       write(out);
       out.flush();
-      if (!out) throw Error("writing " + tmp.string() + " failed");
+      if (!out) throw Error("writing " + path + " failed" + (errno ? std::string(": ") + std::strerror(errno) : ""));
     }
     fs::rename(tmp, target, ec);
-    if (ec) throw Error("cannot rename " + tmp.string() + " to " + path + ": " + ec.message());
+    if (ec) throw Error("cannot write " + path + ": " + ec.message());
   } catch (...) {
     fs::remove(tmp, ec);
     throw;

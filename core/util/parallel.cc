@@ -9,10 +9,20 @@
 
 namespace bimart {
 
+namespace {
+std::atomic<int> default_threads{0};
+int cores() { return std::max(1, static_cast<int>(std::thread::hardware_concurrency())); }
+}  // namespace
+
+int max_threads() { return 4 * cores(); }
+
 int resolve_threads(int threads) {
-  if (threads > 0) return threads;
-  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  if (threads <= 0) threads = default_threads;
+  if (threads <= 0) return cores();
+  return std::min(threads, max_threads());
 }
+
+void set_default_threads(int threads) { default_threads = std::max(0, std::min(threads, max_threads())); }
 
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& job) {
   std::atomic<std::size_t> next{0};

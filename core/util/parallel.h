@@ -9,8 +9,14 @@
 
 namespace bimart {
 
-// `threads` if positive, else the number of cores (at least 1).
+// The most threads any work runs on: 4 x the cores (docs/cli.md). More only adds overhead,
+// and a slip such as --threads 100000 would otherwise start that many.
+int max_threads();
+// `threads` if positive (at most max_threads()), else the default set below, else the
+// number of cores (at least 1).
 int resolve_threads(int threads);
+// The default for resolve_threads(0): the global --threads of the CLI. 0: the cores.
+void set_default_threads(int threads);
 
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& job);
 

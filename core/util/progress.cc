@@ -8,8 +8,15 @@
 
 namespace bimart {
 
+namespace {
+std::atomic<bool> enabled{true};
+}  // namespace
+
+void set_progress_enabled(bool e) { enabled = e; }
+bool progress_enabled() { return enabled; }
+
 ProgressBar::ProgressBar(std::string label, std::size_t total, bool show)
-    : label_(std::move(label)), total_(total), show_(show), tty_(isatty(STDERR_FILENO) != 0) {
+    : label_(std::move(label)), total_(total), show_(show && enabled), tty_(isatty(STDERR_FILENO) != 0) {
   draw();
 }
 

@@ -1,6 +1,7 @@
 // A one-line progress bar on standard error for long work (DESIGN §8): "label [###   ] 3/10",
 // redrawn in place on a terminal; into a file or pipe, one line "label: 3/10" per tenth.
-// step() may be called from several threads. Drawn only when `show` is set.
+// step() may be called from several threads. Drawn only when `show` is set and progress is
+// enabled (the CLI's -q turns it off for every command).
 #pragma once
 
 #include <atomic>
@@ -9,6 +10,9 @@
 #include <string>
 
 namespace bimart {
+
+void set_progress_enabled(bool enabled);
+bool progress_enabled();
 
 class ProgressBar {
  public:

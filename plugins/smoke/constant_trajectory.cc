@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "core/io/sequence.h"
 #include "core/pipeline/plugin.h"
 #include "stages/trajectory_source.h"
 
@@ -14,7 +15,7 @@ class ConstantTrajectory : public TrajectorySource {
  public:
   static StageSpec spec() {
     return StageSpec::of<TrajectorySource>("constant", "a box with a lid held at one state, with optional noise")
-        .param("frames", 64, "number of frames (>= 1)")
+        .param("frames", 64, "number of frames (1 .. 1000000)")
         .param("fps", 30.0, "frames per second (> 0)")
         .param("angle", 0.0, "hinge angle (rad)")
         .param("rotation", std::vector<double>{0, 0, 0}, "root axis-angle (rad)")
@@ -27,7 +28,9 @@ class ConstantTrajectory : public TrajectorySource {
         fps_(p.number("fps")),
         noise_(p.number("noise")),
         state_{p.number("angle")} {
-    if (frames_ < 1) throw Error("frames must be at least 1, got " + std::to_string(frames_));
+    if (frames_ < 1 || frames_ > kMaxFrames)
+      throw Error("frames must be at least 1 and at most " + std::to_string(kMaxFrames) + ", got " +
+                  std::to_string(frames_));
     if (!(fps_ > 0)) throw Error("fps must be positive, got " + std::to_string(fps_));
     if (!(noise_ >= 0)) throw Error("noise must be >= 0, got " + std::to_string(noise_));
     for (const char* name : {"rotation", "translation"}) {

@@ -9,6 +9,7 @@
 #include <ATen/ATen.h>
 #include <nlohmann/json.hpp>
 
+#include "core/hand/hand_model.h"
 #include "core/io/sequence.h"
 #include "core/util/data_path.h"
 #include "core/object/families/families.h"
@@ -25,8 +26,14 @@ using test::CliRun;
 CliRun run_cli(const std::string& args) { return test::run_bimart("eval " + args); }
 
 // Hands hovering 2 cm above the closed box's lid at x = -0.05, moved by `offset` (m) in z.
+// Stored hand_vertices must have the hand model's vertex count (the rule of every command).
+int64_t model_vertices() {
+  static const int64_t v = load_hand_model(find_data_file("models/hand/mano_left.npz")).num_vertices();
+  return v;
+}
+
 Sequence sequence(const std::string& name, const at::Tensor& states, double offset) {
-  const int64_t n = states.size(0), v = 4;
+  const int64_t n = states.size(0), v = model_vertices();
   Sequence s;
   s.name = name;
   s.object = "../objects/box";
