@@ -30,7 +30,8 @@ int dtype_size(const std::string& d) {
   if (d == "f8" || d == "i8" || d == "u8") return 8;
   if (d == "f4" || d == "i4" || d == "u4") return 4;
   if (d == "i1" || d == "u1" || d == "b1") return 1;
-  if (d.size() >= 2 && d[0] == 'U' && std::all_of(d.begin() + 1, d.end(), ::isdigit)) {
+  // At most 7 digits: std::stol would throw on a longer count (found by fuzzing).
+  if (d.size() >= 2 && d.size() <= 8 && d[0] == 'U' && std::all_of(d.begin() + 1, d.end(), ::isdigit)) {
     const long n = std::stol(d.substr(1));
     return n > 0 && n < (1 << 20) ? static_cast<int>(4 * n) : 0;
   }

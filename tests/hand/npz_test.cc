@@ -175,6 +175,14 @@ TEST(NpyTest, ParsesVersion2AndPython2Headers) {
   EXPECT_EQ(as_vector<int>(a), (std::vector<int>{1, 2, 3}));
 }
 
+TEST(NpyTest, RefusesAnEnormousStringLengthWithAnError) {
+  // Found by fuzzing: a U<n> count past long's range made std::stol throw out_of_range.
+  const std::vector<uint8_t> data(48, 0);
+  const auto bytes =
+      npy_with_header("{'descr': '<U99999999999999999999999', 'fortran_order': False, 'shape': (1,), }\n", data);
+  EXPECT_THROW(parse_npy(bytes.data(), bytes.size(), "x.npy"), Error);
+}
+
 TEST(NpyTest, RefusesFortranOrderBigEndianAndTruncation) {
   const std::vector<uint8_t> data(48, 0);
   auto parse = [](const std::vector<uint8_t>& b) { parse_npy(b.data(), b.size(), "x.npy"); };
