@@ -22,8 +22,6 @@
 #include "core/diffusion/checkpoint.h"
 #include "core/diffusion/distributed.h"
 #include "core/diffusion/schedule.h"
-#include "core/hand/hand_model.h"
-#include "core/metrics/hand_vertices.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -175,12 +173,6 @@ void write_loss_log(const std::string& path, const std::vector<LossRow>& rows) {
       out << buf;
     }
   });
-}
-
-std::vector<std::int64_t> hand_keypoint_ids() {
-  const auto files = posing_hand_model_files();
-  const HandModel left = load_hand_model(files[0]);
-  return std::vector<std::int64_t>(left.keypoints.begin(), left.keypoints.end());
 }
 
 }  // namespace
@@ -393,16 +385,21 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   info.diffusion_steps = config.diffusion_steps;
   info.variant = config.variant;
   info.basis_points = train_set.basis_points();
-  info.keypoints = hand_keypoint_ids();
+  info.keypoints = posing_keypoint_ids();
   info.normalization = stats;
   info.config_text = config.text;
   info.data_fingerprint = data_fingerprint(config.data);
 
   // Networks: the trained one and its EMA copy (used for validation and sampling).
+  // Initialisation draws from libtorch's global generator: one training at a time seeds
+  // and builds, so trainings sharing a process (ranks on threads) start alike.
+  static std::mutex init_mutex;
+  std::unique_lock<std::mutex> init_lock(init_mutex);
   torch::manual_seed(config.seed);
   Denoiser net(config.network);
   Denoiser ema_net(config.network);
   load_state(*ema_net, state_of(*net), "EMA copy");
+  init_lock.unlock();
   ema_net->eval();
   torch::optim::Adam opt(net->parameters(), torch::optim::AdamOptions(config.lr).weight_decay(config.weight_decay));
 
