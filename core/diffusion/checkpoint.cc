@@ -5,7 +5,10 @@
 
 #include <cmath>
 
+#include "core/hand/hand_model.h"
+#include "core/hand/keypoints.h"
 #include "core/io/npz.h"
+#include "core/metrics/hand_vertices.h"
 #include "core/io/npz_tensor.h"
 #include "core/util/error.h"
 
@@ -164,6 +167,11 @@ void load_state(torch::nn::Module& module, const TensorMap& weights, const std::
       if (!known) throw Error(what + ": unexpected weights '" + name + "' (another network?)");
     }
   }
+}
+
+std::vector<std::int64_t> posing_keypoint_ids() {
+  const std::vector<int> ids = model_keypoints(load_hand_model(posing_hand_model_files()[0]));
+  return std::vector<std::int64_t>(ids.begin(), ids.end());
 }
 
 Denoiser make_denoiser(const Checkpoint& checkpoint, const std::string& what) {

@@ -64,6 +64,11 @@ TensorMap state_of(const torch::nn::Module& module);
 // missing, unexpected or differently shaped entry.
 void load_state(torch::nn::Module& module, const TensorMap& weights, const std::string& what);
 
+// The J = 100 keypoint vertex ids of the hand model the metrics pose with
+// (posing_hand_model_files, core/metrics/hand_vertices.h), checked by model_keypoints: what
+// a model is trained with and what a stage compares a checkpoint against.
+std::vector<std::int64_t> posing_keypoint_ids();
+
 // A denoiser built from the checkpoint's config with its sampling weights, in eval mode.
 Denoiser make_denoiser(const Checkpoint& checkpoint, const std::string& what);
 

@@ -5,8 +5,6 @@
 
 #include <chrono>
 
-#include "core/hand/hand_model.h"
-#include "core/metrics/hand_vertices.h"
 #include "core/pipeline/plugin.h"
 #include "core/util/log.h"
 #include "model_params.h"
@@ -33,10 +31,8 @@ class MotionDiffusion : public MotionGenerator {
     s_.options.use_contact = p.boolean("use_contact");
     if (s_.model->info().network.model != "motion")
       throw Error(s_.model->path() + " is a " + s_.model->info().network.model + " model, not a motion model");
-    const auto files = posing_hand_model_files();
-    const HandModel hand = load_hand_model(files[0]);
     diffusion::check_compatible(s_.model->info(), s_.model->path(), "motion", "", {},
-                                std::vector<std::int64_t>(hand.keypoints.begin(), hand.keypoints.end()));
+                                diffusion::posing_keypoint_ids());
   }
 
   void run(StageIO& io) override {
