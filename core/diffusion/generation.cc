@@ -50,6 +50,71 @@ std::vector<std::pair<std::int64_t, std::int64_t>> DiffusionModel::windows(std::
   return w;
 }
 
+namespace {
+
+// Blending weights of one window over its frames: 1 inside, a raised-cosine ramp over the
+// frames it shares with the previous window (up) and with the next one (down); the two
+// ramps multiply where they meet (overlaps longer than half a window).
+at::Tensor window_weights(const std::vector<std::pair<std::int64_t, std::int64_t>>& spans, std::size_t k) {
+  const auto [start, length] = spans[k];
+  at::Tensor w = at::ones({length}, at::kDouble);
+  const auto ramp = [](std::int64_t n) {  // n values rising in (0, 1)
+    at::Tensor i = at::arange(n, at::kDouble).add_(0.5).mul_(M_PI / static_cast<double>(n));
+    return i.cos().mul_(-0.5).add_(0.5);
+  };
+  if (k > 0) {
+    const std::int64_t ov = spans[k - 1].first + spans[k - 1].second - start;
+    if (ov > 0) w.slice(0, 0, ov).mul_(ramp(ov));
+  }
+  if (k + 1 < spans.size()) {
+    const std::int64_t ov = start + length - spans[k + 1].first;
+    if (ov > 0) w.slice(0, length - ov, length).mul_(ramp(ov).flip(0));
+  }
+  return w.to(at::kFloat);
+}
+
+// Windows of a sequence batched as [K * S, L, D] (window-major: row k * S + s is sample s of
+// window k) and the sequence [S, N, D] they cover. Every denoising step fuses the windows'
+// estimates into one sequence (a weighted mean where they overlap) and hands each window
+// its part back, so neighbouring windows agree on their shared frames at every step
+// (MultiDiffusion, Bar-Tal et al. 2023) and no seam is left to cross-fade at the end.
+struct WindowLayout {
+  std::vector<std::pair<std::int64_t, std::int64_t>> spans;
+  std::int64_t frames = 0, samples = 0, length = 0;
+  std::vector<at::Tensor> weights;  // [L] per window
+  at::Tensor total;                 // [N]: sum of the weights covering each frame
+
+  WindowLayout(std::vector<std::pair<std::int64_t, std::int64_t>> s, std::int64_t n, std::int64_t samples_)
+      : spans(std::move(s)), frames(n), samples(samples_), length(spans.front().second) {
+    total = at::zeros({n});
+    for (std::size_t k = 0; k < spans.size(); ++k) {
+      weights.push_back(window_weights(spans, k));
+      total.slice(0, spans[k].first, spans[k].first + length) += weights.back();
+    }
+  }
+  std::int64_t count() const { return static_cast<std::int64_t>(spans.size()); }
+
+  at::Tensor fuse(const at::Tensor& windows) const {  // [K * S, L, D] -> [S, N, D]
+    const std::int64_t D = windows.size(2);
+    at::Tensor seq = at::zeros({samples, frames, D}, windows.options());
+    const at::Tensor per = windows.view({count(), samples, length, D});
+    for (std::int64_t k = 0; k < count(); ++k)
+      seq.slice(1, spans[k].first, spans[k].first + length) += per[k] * weights[k].view({1, length, 1});
+    return seq / total.view({1, frames, 1});
+  }
+  at::Tensor split(const at::Tensor& seq) const {  // [S, N, D] -> [K * S, L, D]
+    std::vector<at::Tensor> parts;
+    for (const auto& [start, len] : spans) parts.push_back(seq.slice(1, start, start + len));
+    return at::cat(parts, 0).contiguous();
+  }
+  // A per-window tensor [K, L, ...] (conditions) repeated for every sample: [K * S, L, ...].
+  at::Tensor per_sample(const at::Tensor& per_window) const {
+    return per_window.repeat_interleave(samples, 0).contiguous();
+  }
+};
+
+}  // namespace
+
 at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, const at::Tensor& C,
                                     const Guidance* guidance, const GenerateOptions& o, at::Generator gen) const {
   c10::InferenceMode inference;
@@ -72,56 +137,50 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   }
   const int W = window();
   const int D = info.network.sample_size;
-  const auto spans = windows(N, W, std::min(o.overlap, W - 1));
-  at::Tensor result = at::zeros({S, N, D});
-  at::Tensor weight = at::zeros({N});
+  const WindowLayout lay(windows(N, W, std::min(o.overlap, W - 1)), N, S);
+  const std::int64_t K = lay.count(), B = K * S;
 
-  for (const auto& [start, length] : spans) {
-    // Conditions of the window, padded to its length by repeating the last frame.
-    at::Tensor o_w = O.slice(0, start, start + length).to(at::kFloat);
+  // Conditions of every window, encoded once: the object features and the global states
+  // with each window's translation taken relative to its own first frame.
+  std::vector<at::Tensor> objs;
+  for (const auto& [start, length] : lay.spans) {
+    const at::Tensor o_w = O.slice(0, start, start + length).to(at::kFloat);
     at::Tensor g_w = G.slice(0, start, start + length).to(at::kFloat).clone();
     g_w.slice(1, 3, 6) -= g_w.slice(0, 0, 1).slice(1, 3, 6);
-    const at::Tensor obj = st.normalize_object(o_w, g_w).unsqueeze(0).expand({S, length, kObjectConditionSize}).contiguous();
-    at::Tensor cond_emb;
-    if (!motion) {
-      cond_emb = net_->encode_conditions(obj);
-    } else {
-      at::Tensor c_w;
-      if (contact.defined()) c_w = st.normalize_c(contact.slice(1, start, start + length).to(at::kFloat)).flatten(-2);
-      const at::Tensor with = contact.defined() ? net_->encode_conditions(obj, c_w) : net_->encode_conditions(obj);
-      if (o.cfg_lambda != 0.0 && contact.defined()) {
-        const at::Tensor without = net_->encode_conditions(obj);
-        cond_emb = at::cat({with, without}, 0);
-      } else {
-        cond_emb = with;
-      }
-    }
-    const bool cfg = cond_emb.size(0) == 2 * S;
-    const auto predict = [&](const at::Tensor& x_t, int t) {
-      const at::Tensor xin = cfg ? at::cat({x_t, x_t}, 0) : x_t;
-      const at::Tensor steps = at::full({xin.size(0)}, t, at::kLong);
-      const at::Tensor out = net_->forward(xin, steps, cond_emb);
-      at::Tensor x0 = cfg ? out.slice(0, 0, S) : out;
-      if (guidance != nullptr && motion) {
-        const at::Tensor metres = st.denormalize_x(x0);
-        const at::Tensor corr = guidance->correction(metres, start, t, schedule_.steps);
-        x0 = st.normalize_x(metres + corr);
-      }
-      if (cfg) x0 = combine_cfg(x0, out.slice(0, S, 2 * S), o.cfg_lambda);
-      return x0;
-    };
-    const at::Tensor noise = at::randn({S, length, D}, gen);
-    const at::Tensor x = sample(schedule_, predict, noise, o.sampler, gen);
-    // Cross-fade: weights ramp up over the overlap at the start of every window but the
-    // first and down at the end of every window but the last.
-    at::Tensor w = at::ones({length});
-    const std::int64_t ov = std::min<std::int64_t>(o.overlap, length);
-    if (start > 0 && ov > 0) w.slice(0, 0, ov).copy_(at::linspace(1.0 / (ov + 1), ov / (ov + 1.0), ov));
-    if (start + length < N && ov > 0) w.slice(0, length - ov, length).mul_(at::linspace(ov / (ov + 1.0), 1.0 / (ov + 1), ov));
-    result.slice(1, start, start + length) += x * w.view({1, length, 1});
-    weight.slice(0, start, start + length) += w;
+    objs.push_back(st.normalize_object(o_w, g_w));
   }
-  result /= weight.view({1, N, 1});
+  const at::Tensor obj = lay.per_sample(at::stack(objs, 0));  // [B, L, 3079]
+  at::Tensor cond_emb;
+  if (!motion) {
+    cond_emb = net_->encode_conditions(obj);
+  } else {
+    at::Tensor c_w;
+    if (contact.defined()) c_w = lay.split(st.normalize_c(contact.to(at::kFloat)).flatten(-2));
+    const at::Tensor with = contact.defined() ? net_->encode_conditions(obj, c_w) : net_->encode_conditions(obj);
+    cond_emb = o.cfg_lambda != 0.0 && contact.defined() ? at::cat({with, net_->encode_conditions(obj)}, 0) : with;
+  }
+  const bool cfg = cond_emb.size(0) == 2 * B;
+
+  const auto predict = [&](const at::Tensor& x_t, int t) {
+    const at::Tensor xin = cfg ? at::cat({x_t, x_t}, 0) : x_t;
+    const at::Tensor out = net_->forward(xin, at::full({xin.size(0)}, t, at::kLong), cond_emb);
+    at::Tensor x0 = cfg ? out.slice(0, 0, B) : out;
+    if (guidance != nullptr && motion) {
+      const at::Tensor metres = st.denormalize_x(x0);
+      std::vector<at::Tensor> corr;
+      for (std::int64_t k = 0; k < K; ++k)
+        corr.push_back(guidance->correction(metres.slice(0, k * S, (k + 1) * S), lay.spans[k].first, t, schedule_.steps));
+      x0 = st.normalize_x(metres + at::cat(corr, 0));
+    }
+    if (cfg) x0 = combine_cfg(x0, out.slice(0, B, 2 * B), o.cfg_lambda);
+    return K == 1 ? x0 : lay.split(lay.fuse(x0));
+  };
+  // One noise per sequence frame, so shared frames start equal; fused again after every step.
+  const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));
+  const StepHook agree = [&](int, int, at::Tensor& x) {
+    if (K > 1) x = lay.split(lay.fuse(x));
+  };
+  const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, agree));
   if (!motion) return st.denormalize_c(result.view({S, N, 2, 1024})).clamp_min(0.0);
   return st.denormalize_x(result);
 }

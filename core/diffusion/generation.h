@@ -1,8 +1,9 @@
-// Sampling a trained model over a whole sequence (DESIGN §2, §5): the conditions are
-// encoded once per window, windows of the model's length cover the sequence with an
-// overlap that is cross-faded, several samples run as one batch, and for the motion model
-// classifier-free guidance runs both passes in one batched forward, with an optional
-// guidance correction of the conditional x0 prediction at every step.
+// Sampling a trained model over a whole sequence (DESIGN §2, §5): windows of the model's
+// length cover the sequence with an overlap, all windows and samples are denoised as one
+// batch and fused into one sequence at every step (so shared frames agree), the
+// conditions are encoded once per window, and for the motion model classifier-free
+// guidance runs both passes in one batched forward, with an optional guidance correction
+// of the conditional x0 prediction at every step.
 #pragma once
 
 #include <cstdint>
@@ -25,7 +26,7 @@ struct GenerateOptions {
   SamplerOptions sampler;   // ddpm (all steps) or ddim
   double cfg_lambda = 0.5;  // motion model: (1 + λ)·cond − λ·uncond; 0 = conditional only
   int samples = 1;          // batched
-  int overlap = 16;         // frames shared by consecutive windows (cross-faded)
+  int overlap = 48;         // frames shared by consecutive windows (fused at every step)
   bool use_contact = true;  // motion model: false = null contact token ("w/o C")
 };
 

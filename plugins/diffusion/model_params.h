@@ -18,7 +18,7 @@ inline void declare_sampling_params(StageSpec& s, const char* default_checkpoint
       .param("steps", 0, "DDIM steps (0 = every step of the schedule)")
       .param("eta", 0.0, "DDIM noise (0 = deterministic)")
       .param("samples", 1, "samples generated at once (batched); the first is the stage's main output")
-      .param("overlap", 16, "frames shared by consecutive windows of a long sequence (cross-faded)");
+      .param("overlap", 48, "frames shared by consecutive windows of a long sequence (fused at every denoising step)");
 }
 
 struct Sampling {
