@@ -321,7 +321,7 @@ TEST(GraphVars, WholeValueKeepsTheTypeAndTextIsSpliced) {
   const YAML::Node spliced = f.substitute(YAML::Node("${out}/a_${label}.npz"));
   EXPECT_EQ(spliced.Scalar(), "out/x/a_hello.npz");
   EXPECT_EQ(f.substitute(YAML::Node("cost $$5 and $${out}")).Scalar(), "cost $$5 and ${out}");
-  EXPECT_EQ(f.substitute(YAML::Load("[${out}, 2]"))[0].Scalar(), "out/x");
+  EXPECT_EQ(f.substitute(YAML::Load("[\"${out}\", 2]"))[0].Scalar(), "out/x");
   f.set_var("value=4");  // as --var value=4
   const Graph g = validate(f, registry());
   EXPECT_DOUBLE_EQ(g.node("src").params.number("value"), 4.0);
@@ -392,7 +392,7 @@ TEST(GraphVars, BadValuesAndNames) {
     validate(f, registry());
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_HAS(e.what(), "test.yaml:9:21: stage 'src' parameter 'value' expects a float, got 'abc' (from '${value}')");
+    EXPECT_HAS(e.what(), "test.yaml:8:21: stage 'src' parameter 'value' expects a float, got 'abc' (from '${value}')");
   }
   EXPECT_HAS(error_of("vars: {Bad: 1}\nstages:\n  - {id: src, use: test.source}\n"),
              "variable name 'Bad' must be lower case");
