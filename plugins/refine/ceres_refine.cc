@@ -71,7 +71,7 @@ class CeresRefineStage : public Refiner {
       o.threads = threads;
       RefineReport report;
       HandMotion motion = refine_hands(models, distance, states, X, start, o, &report);
-      log::info("refine.ceres: sample {}: {} frames in {:.2f} s\n{}", k, X.size(0), report.seconds,
+      log::info("refine.ceres: {} frames in {:.2f} s (sample {})\n{}", X.size(0), report.seconds, k,
                 format_refine_report(report));
       return motion;
     });

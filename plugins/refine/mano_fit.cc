@@ -47,9 +47,9 @@ class ManoFitStage : public Refiner {
       o.threads = threads;
       ManoFitReport report;
       HandMotion motion = fit_mano(hands_->pointers(), hand_features_to_world(X, states).positions, o, &report);
-      log::info("mano_fit: sample {}: {} frames, mean keypoint error {:.2f} / {:.2f} mm (left / right), {:.2f} s", k,
+      log::info("mano_fit: {} frames, mean keypoint error {:.2f} / {:.2f} mm (left / right), {:.2f} s (sample {})",
                 X.size(0), 1e3 * report.hands[0].mean_keypoint_error, 1e3 * report.hands[1].mean_keypoint_error,
-                report.seconds);
+                report.seconds, k);
       return motion;
     });
   }
