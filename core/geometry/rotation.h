@@ -4,8 +4,6 @@
 
 #include <Eigen/Core>
 
-#include <string>
-
 namespace bimart {
 
 // Rodrigues' formula; exact identity for a zero vector, Taylor terms for tiny angles.
@@ -21,12 +19,5 @@ Eigen::Matrix3d rotation_about(const Eigen::Vector3d& axis, double angle);
 // The smallest rotation taking direction `from` to direction `to` (both non-zero). For
 // opposite directions it turns by pi about an axis perpendicular to `from`.
 Eigen::Matrix3d rotation_between(const Eigen::Vector3d& from, const Eigen::Vector3d& to);
-
-// Euler angles (radians) in the order `order`, three of x, y, z with no letter twice in a
-// row ("xyz", "zyx", "zxz", ...), about the fixed (world) axes: "xyz" turns by a about x,
-// then by b about y, then by c about z, R = Rz(c) Ry(b) Rx(a) (Blender's "XYZ Euler",
-// SciPy's lower-case "xyz"). Throws std::invalid_argument for another order.
-Eigen::Matrix3d euler_to_matrix(const std::string& order, const Eigen::Vector3d& angles);
-bool is_euler_order(const std::string& order);
 
 }  // namespace bimart

@@ -8,7 +8,8 @@
 #include "core/geometry/rotation.h"
 #include "core/object/families/families.h"
 #include "core/object/object_io.h"
-#include "core/util/atomic_file.h"
+#include "core/object/part_checks.h"
+#include "core/util/atomic_folder.h"
 #include "core/util/error.h"
 #include "core/util/output_path.h"
 

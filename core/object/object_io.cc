@@ -14,6 +14,7 @@
 
 #include "core/geometry/rotation.h"
 #include "core/object/families/families.h"
+#include "core/object/part_checks.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
 #include "core/util/log.h"

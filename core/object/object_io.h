@@ -57,8 +57,5 @@ constexpr double kMaxPartRadius = 3.0;
 constexpr int kMinPartFaces = 4;
 constexpr double kMinPartVolumeRatio = 1e-6;
 constexpr double kMaxHingeGapRatio = 2.0;
-// Throws bimart::Error naming `path` and the measured value when a closed canonical part
-// fails one of these (the hinge point is the origin).
-void check_part_shape(const TriangleMesh& mesh, const std::string& path);
 
 }  // namespace bimart

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/geometry/euler.h"
 #include "core/geometry/rotation.h"
 #include "core/trajectory/keyframes.h"
 #include "core/trajectory/validation.h"

@@ -12,10 +12,4 @@ namespace bimart {
 // the target is then untouched and the temporary file removed.
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
-// The same for a folder: `write` fills a temporary sibling folder, which then replaces
-// `dir`. An existing `dir` is replaced only with `replace` (else an error, before `write`
-// runs); on any failure `dir` is untouched and the temporary folder removed.
-void write_folder_atomically(const std::string& dir, const std::function<void(const std::string& tmp_dir)>& write,
-                             bool replace);
-
 }  // namespace bimart

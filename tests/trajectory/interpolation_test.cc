@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "core/geometry/euler.h"
 #include "core/geometry/rotation.h"
 #include "core/trajectory/cubic_spline.h"
 #include "core/trajectory/keyframes.h"
