@@ -48,6 +48,7 @@ void sample_keyframes(const std::vector<Keyframe>& keys, double fps, bool rest, 
   std::vector<double> ang;
   std::vector<Eigen::Quaterniond> rot;
   std::vector<int> angle_lines;
+  out.angle_keys.clear();
   for (const Keyframe& k : keys) {
     if (k.position) {
       tp.push_back(k.t);
