@@ -63,11 +63,11 @@ ArticulatedObject import_object(const ImportOptions& options, ImportReport* repo
 double object_size(const ArticulatedObject& object);
 
 // Sizes of the objects the shipped models were trained on: every procedural family over
-// seeds 0..9 measures 0.126 m (ketchup) to 0.543 m (microwave) with object_size
+// seeds 0..9 measures 0.0858 m to 0.5375 m with object_size
 // (tests/trajectory/object_import_test.cc re-measures it); an import more than
 // kSizeWarningFactor outside this range gets a warning.
-constexpr double kTrainingSizeMin = 0.12;
-constexpr double kTrainingSizeMax = 0.55;
+constexpr double kTrainingSizeMin = 0.085;
+constexpr double kTrainingSizeMax = 0.54;
 constexpr double kSizeWarningFactor = 2.0;
 // The measured range of object_size over every family and seeds [0, seeds).
 std::pair<double, double> procedural_size_range(int seeds);

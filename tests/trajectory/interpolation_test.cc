@@ -192,7 +192,7 @@ TEST(Keyframes, ChannelsHoldOutsideTheirKeys) {
   ASSERT_EQ(tr.num_frames(), 61);
   for (Eigen::Index f = 0; f <= 30; ++f) EXPECT_DOUBLE_EQ(tr.states(f, 0), 0.2);  // before its first key
   EXPECT_NEAR(tr.states(60, 0), 1.0, 1e-12);
-  for (Eigen::Index f = 0; f < 61; ++f) EXPECT_LT(tr.states.block<1, 3>(f, 1).norm(), 1e-15);  // no rotation key
+  for (Eigen::Index f = 0; f < 61; ++f) EXPECT_LT((tr.states.block<1, 3>(f, 1).norm()), 1e-15);  // no rotation key
   // A key time off the frame grid: frames stop at the last whole frame.
   k[2].t = 2.01;
   sample_keyframes(k, 30, true, "k.yaml", tr);

@@ -17,6 +17,7 @@
 #include "core/object/mesh_repair.h"
 #include "core/object/object_io.h"
 #include "core/object/object_state.h"
+#include "core/util/error.h"
 
 namespace bimart {
 namespace {

@@ -12,6 +12,7 @@
 
 #include "core/io/sequence.h"
 #include "core/object/families/families.h"
+#include "core/object/object_io.h"
 #include "core/trajectory/trajectory.h"
 #include "core/trajectory/trajectory_object.h"
 #include "core/trajectory/validation.h"
