@@ -63,17 +63,21 @@ int import(const ImportArgs& a) {
     std::error_code ec;
     return x == y || fs::equivalent(x, y, ec);
   };
-  if (a.meshes.size() != 2) throw Error("give two mesh files, the moving part (--top) and the fixed part");
-  if (same(a.meshes[0], a.meshes[1])) throw Error("the two mesh files are the same file: " + a.meshes[0]);
   ImportOptions o;
-  if (same(a.top, a.meshes[0])) {
-    o.top = a.meshes[0];
-    o.bottom = a.meshes[1];
-  } else if (same(a.top, a.meshes[1])) {
-    o.top = a.meshes[1];
-    o.bottom = a.meshes[0];
+  if (a.meshes.size() == 1) {  // one OBJ, parts labelled by groups
+    o.labelled = a.meshes[0];
+    o.top_label = a.top;
   } else {
-    throw Error("--top " + a.top + " is neither of the two mesh files (" + a.meshes[0] + ", " + a.meshes[1] + ")");
+    if (same(a.meshes[0], a.meshes[1])) throw Error("the two mesh files are the same file: " + a.meshes[0]);
+    if (same(a.top, a.meshes[0])) {
+      o.top = a.meshes[0];
+      o.bottom = a.meshes[1];
+    } else if (same(a.top, a.meshes[1])) {
+      o.top = a.meshes[1];
+      o.bottom = a.meshes[0];
+    } else {
+      throw Error("--top " + a.top + " is neither of the two mesh files (" + a.meshes[0] + ", " + a.meshes[1] + ")");
+    }
   }
   if (!a.through.empty()) {
     o.hinge = hinge_through({a.through[0], a.through[1], a.through[2]}, {a.through[3], a.through[4], a.through[5]});
@@ -156,8 +160,15 @@ void add_object_commands(CLI::App& app, Commands& out) {
   static ImportArgs imp;
   CLI::App* import_cmd = object->add_subcommand(
       "import", "your own object: two part meshes and the hinge, written canonical (docs/trajectories.md)");
-  import_cmd->add_option("meshes", imp.meshes, "the two part meshes (OBJ, PLY, OFF or STL)")->expected(2)->required();
-  import_cmd->add_option("--top", imp.top, "which of the two meshes moves (the lid, screen, cap, ...)")->required();
+  import_cmd
+      ->add_option("meshes", imp.meshes,
+                   "the two part meshes (OBJ, PLY, OFF or STL), or one OBJ whose groups (g/o lines) label the parts")
+      ->expected(1, 2)
+      ->required();
+  import_cmd
+      ->add_option("--top", imp.top,
+                   "which part moves (the lid, screen, cap, ...): one of the two files, or the group name in one OBJ")
+      ->required();
   CLI::Option* pivot = import_cmd->add_option("--pivot", imp.pivot, "a point on the hinge axis (X Y Z, in --units)")
                            ->expected(3);
   CLI::Option* axis =

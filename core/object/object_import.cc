@@ -2,8 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "core/geometry/rotation.h"
 #include "core/object/families/families.h"
@@ -12,6 +16,7 @@
 #include "core/util/atomic_folder.h"
 #include "core/util/error.h"
 #include "core/util/output_path.h"
+#include "core/util/text.h"
 
 namespace bimart {
 
@@ -38,10 +43,32 @@ void transform(TriangleMesh& m, const Eigen::Isometry3d& t) {
     m.vertices.row(i) = (t * Eigen::Vector3d(m.vertices.row(i))).transpose();
 }
 
-// Reads and checks one part, in metres.
-TriangleMesh read_part(const std::string& path, double scale, ImportedPart& info) {
+// The faces of `m` where `keep[f]`, with only the vertices they use.
+TriangleMesh select_faces(const TriangleMesh& m, const std::vector<bool>& keep) {
+  std::vector<int> index(m.num_vertices(), -1);
+  std::vector<Eigen::Index> vertices, faces;
+  for (Eigen::Index f = 0; f < m.num_faces(); ++f)
+    if (keep[f]) {
+      faces.push_back(f);
+      for (int c = 0; c < 3; ++c)
+        if (index[m.faces(f, c)] < 0) {
+          index[m.faces(f, c)] = static_cast<int>(vertices.size());
+          vertices.push_back(m.faces(f, c));
+        }
+    }
+  TriangleMesh out;
+  out.vertices.resize(static_cast<Eigen::Index>(vertices.size()), 3);
+  for (std::size_t i = 0; i < vertices.size(); ++i) out.vertices.row(i) = m.vertices.row(vertices[i]);
+  out.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int c = 0; c < 3; ++c) out.faces(i, c) = index[m.faces(faces[i], c)];
+  return out;
+}
+
+// Reads and checks one part, in metres (`given`: already read, e.g. split from one file).
+TriangleMesh read_part(const std::string& path, double scale, ImportedPart& info, const TriangleMesh* given = nullptr) {
   info.file = path;
-  TriangleMesh m = read_mesh_file(path);
+  TriangleMesh m = given ? *given : read_mesh_file(path);
   validate_mesh(m, path);
   info.vertices_read = m.num_vertices();
   info.faces_read = m.num_faces();
@@ -57,6 +84,46 @@ TriangleMesh read_part(const std::string& path, double scale, ImportedPart& info
 double deg(double rad) { return rad * 180 / M_PI; }
 
 }  // namespace
+
+std::pair<TriangleMesh, TriangleMesh> split_labelled_obj(const std::string& path, const std::string& top_label) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".obj") throw Error(path + ": part labels are read from OBJ groups (g or o lines); give two files instead");
+  const TriangleMesh m = read_mesh_file(path);  // checked; polygons split as fans, in file order
+  // The group of every face line, one entry per triangle it becomes.
+  std::ifstream in(path);
+  std::vector<bool> top;
+  std::vector<std::string> groups;
+  std::string line, group = "(no group)";
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string kind;
+    ls >> kind;
+    if (kind == "g" || kind == "o") {
+      std::string name, word;
+      while (ls >> word) name += (name.empty() ? "" : " ") + word;
+      group = name.empty() ? "(no group)" : name;
+      if (std::find(groups.begin(), groups.end(), group) == groups.end()) groups.push_back(group);
+    } else if (kind == "f") {
+      int corners = 0;
+      std::string word;
+      while (ls >> word) ++corners;
+      for (int k = 0; k + 2 < corners; ++k) top.push_back(group == top_label);
+    }
+  }
+  if (static_cast<Eigen::Index>(top.size()) != m.num_faces())
+    throw Error(fmt::format("{}: counted {} triangles in its face lines but read {}", path, top.size(), m.num_faces()));
+  const auto n_top = std::count(top.begin(), top.end(), true);
+  const std::string names = groups.empty() ? "none" : "'" + join(groups, "', '") + "'";
+  if (n_top == 0)
+    throw Error(fmt::format("{}: no group '{}' with faces (its groups: {})", path, top_label, names));
+  if (n_top == m.num_faces())
+    throw Error(fmt::format("{}: every face is in group '{}'; the fixed part needs the others (its groups: {})", path,
+                            top_label, names));
+  std::vector<bool> bottom(top.size());
+  for (std::size_t f = 0; f < top.size(); ++f) bottom[f] = !top[f];
+  return {select_faces(m, top), select_faces(m, bottom)};
+}
 
 HingeAxis hinge_through(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return {a, b - a}; }
 
@@ -91,8 +158,16 @@ ArticulatedObject import_object(const ImportOptions& opt, ImportReport* out) {
   ArticulatedObject o;
   o.name = opt.name;
   o.category = opt.category;
-  TriangleMesh top = read_part(opt.top, scale, rep.top);
-  TriangleMesh bottom = read_part(opt.bottom, scale, rep.bottom);
+  TriangleMesh top, bottom;
+  if (!opt.labelled.empty()) {
+    const auto parts = split_labelled_obj(opt.labelled, opt.top_label);
+    top = read_part(opt.labelled + " (group " + opt.top_label + ")", scale, rep.top, &parts.first);
+    bottom = read_part(opt.labelled + " (other groups)", scale, rep.bottom, &parts.second);
+  } else {
+    top = read_part(opt.top, scale, rep.top);
+    bottom = read_part(opt.bottom, scale, rep.bottom);
+  }
+  const std::string top_name = rep.top.file, bottom_name = rep.bottom.file;
   const double extent = std::max(bounding_radius(top), bounding_radius(bottom));
   // Zero against the parts' size: the direction is in the files' units like the points.
   if (!(opt.hinge.direction.norm() * scale > 1e-9 * extent))
@@ -106,8 +181,8 @@ ArticulatedObject import_object(const ImportOptions& opt, ImportReport* out) {
   t.translation() = -(t.linear() * (scale * opt.hinge.point));
   transform(top, t);
   transform(bottom, t);
-  rep.top.repair = close_and_orient(top, opt.top);
-  rep.bottom.repair = close_and_orient(bottom, opt.bottom);
+  rep.top.repair = close_and_orient(top, top_name);
+  rep.bottom.repair = close_and_orient(bottom, bottom_name);
 
   // 2. About the axis: the top part above the bottom part (+y), as in every family.
   const Eigen::Vector3d ct = surface_centroid(top), cb = surface_centroid(bottom);
@@ -131,7 +206,7 @@ ArticulatedObject import_object(const ImportOptions& opt, ImportReport* out) {
   transform(bottom, shift);
   rep.to_canonical = shift * roll * t;
 
-  for (const auto& [mesh, file] : {std::pair{&top, &opt.top}, {&bottom, &opt.bottom}}) {
+  for (const auto& [mesh, file] : {std::pair{&top, &top_name}, {&bottom, &bottom_name}}) {
     try {
       check_part_shape(*mesh, *file);
     } catch (const Error& e) {
@@ -163,8 +238,10 @@ ArticulatedObject import_object(const ImportOptions& opt, ImportReport* out) {
   if (!(std::isfinite(o.open_angle) && o.open_angle >= o.angle_min && o.open_angle <= o.angle_max))
     throw Error(fmt::format("--open {} deg is outside the limits [{}, {}] deg", deg(o.open_angle), deg(o.angle_min),
                             deg(o.angle_max)));
-  o.units_note = fmt::format("imported from {} and {} ({})", fs::path(opt.top).filename().string(),
-                             fs::path(opt.bottom).filename().string(), opt.units);
+  o.units_note = opt.labelled.empty() ? fmt::format("imported from {} and {} ({})", fs::path(opt.top).filename().string(),
+                                                    fs::path(opt.bottom).filename().string(), opt.units)
+                                      : fmt::format("imported from {} ({})", fs::path(opt.labelled).filename().string(),
+                                                    opt.units);
 
   rep.size = object_size(o);
   if (rep.size < kTrainingSizeMin / kSizeWarningFactor || rep.size > kTrainingSizeMax * kSizeWarningFactor)

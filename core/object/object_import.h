@@ -32,6 +32,10 @@ HingeAxis hinge_through(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 struct ImportOptions {
   std::string top;     // mesh file of the moving part (OBJ, PLY, OFF, STL)
   std::string bottom;  // mesh file of the fixed part
+  // Instead of two files: one OBJ whose groups (`g NAME` or `o NAME` lines) label the parts;
+  // the faces of group `top_label` move, all others are the fixed part.
+  std::string labelled;
+  std::string top_label;
   HingeAxis hinge;
   std::string units = "m";  // m | cm | mm: of the meshes and the hinge point
   std::string name = "imported";
@@ -58,6 +62,11 @@ struct ImportReport {
 // Throws bimart::Error naming the file or the option at fault: unreadable or bad mesh, a
 // zero hinge direction, a part far from the hinge, units, limits.
 ArticulatedObject import_object(const ImportOptions& options, ImportReport* report = nullptr);
+
+// The two parts of an OBJ file with groups: faces of the group `top_label` and all others.
+// Throws bimart::Error naming the file and the groups it has when the label is missing or
+// no face is left for the other part.
+std::pair<TriangleMesh, TriangleMesh> split_labelled_obj(const std::string& path, const std::string& top_label);
 
 // Largest side (m) of the axis-aligned box around both parts, closed (angle 0).
 double object_size(const ArticulatedObject& object);

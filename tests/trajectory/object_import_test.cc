@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <random>
+#include <tuple>
 
 #include "core/geometry/rotation.h"
 #include "core/object/mesh_repair.h"
@@ -147,6 +148,40 @@ TEST_F(ObjectImport, TwoPointsOnTheAxisGiveTheSameObject) {
   const ArticulatedObject out = import_object(o);
   EXPECT_LT(max_vertex_gap(out.top, box.top), 1e-4);
   EXPECT_LT(max_vertex_gap(out.bottom, box.bottom), 1e-4);
+}
+
+TEST_F(ObjectImport, OneObjWithGroupsGivesTheSameObject) {
+  const ArticulatedObject box = canonical_box();
+  // Both parts in one file, the lid as group "lid", the base as "base"; an empty group last.
+  std::ofstream out(path("both.obj"));
+  out << "# exported\no box\n";
+  for (const TriangleMesh* m : {&box.bottom, &box.top})
+    for (Eigen::Index i = 0; i < m->num_vertices(); ++i) {
+      const Eigen::Vector3d v = 1000 * (pose_ * Eigen::Vector3d(m->vertices.row(i)));
+      out << fmt::format("v {:.17g} {:.17g} {:.17g}\n", v.x(), v.y(), v.z());
+    }
+  for (const auto& [name, m, offset] : {std::tuple{"base", &box.bottom, 1}, {"lid", &box.top, 9}}) {
+    out << "g " << name << "\n";
+    for (Eigen::Index f = 0; f < m->num_faces(); ++f)
+      out << fmt::format("f {} {} {}\n", m->faces(f, 0) + offset, m->faces(f, 1) + offset, m->faces(f, 2) + offset);
+  }
+  out << "g other\n";
+  out.close();
+  ImportOptions o = options("", "");
+  o.labelled = path("both.obj");
+  o.top_label = "lid";
+  ImportReport report;
+  const ArticulatedObject imported = import_object(o, &report);
+  EXPECT_EQ(report.top.vertices_read, 8);
+  EXPECT_EQ(report.bottom.vertices_read, 8);
+  EXPECT_LT(max_vertex_gap(imported.top, box.top), 1e-4);
+  EXPECT_LT(max_vertex_gap(imported.bottom, box.bottom), 1e-4);
+  // A label the file lacks names the groups it has.
+  o.top_label = "cap";
+  const std::string e = error_of([&] { import_object(o); });
+  EXPECT_NE(e.find("no group 'cap' with faces (its groups: 'box', 'base', 'lid', 'other')"), std::string::npos) << e;
+  o.labelled = write_mesh(box.top, "lid.stl");
+  EXPECT_NE(error_of([&] { import_object(o); }).find("OBJ groups"), std::string::npos);
 }
 
 TEST_F(ObjectImport, HolesAreFilledAndReported) {
