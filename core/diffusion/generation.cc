@@ -161,6 +161,8 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   }
   const bool cfg = cond_emb.size(0) == 2 * B;
 
+  // Every window takes its part of the fused sequence (nothing to fuse for one window).
+  const auto agree = [&](const at::Tensor& x) { return K == 1 ? x : lay.split(lay.fuse(x)); };
   const auto predict = [&](const at::Tensor& x_t, int t) {
     const at::Tensor xin = cfg ? at::cat({x_t, x_t}, 0) : x_t;
     const at::Tensor out = net_->forward(xin, at::full({xin.size(0)}, t, at::kLong), cond_emb);
@@ -173,14 +175,12 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
       x0 = st.normalize_x(metres + at::cat(corr, 0));
     }
     if (cfg) x0 = combine_cfg(x0, out.slice(0, B, 2 * B), o.cfg_lambda);
-    return K == 1 ? x0 : lay.split(lay.fuse(x0));
+    return agree(x0);
   };
   // One noise per sequence frame, so shared frames start equal; fused again after every step.
   const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));
-  const StepHook agree = [&](int, int, at::Tensor& x) {
-    if (K > 1) x = lay.split(lay.fuse(x));
-  };
-  const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, agree));
+  const StepHook hook = [&](int, int, at::Tensor& x) { x = agree(x); };
+  const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, hook));
   if (!motion) return st.denormalize_c(result.view({S, N, 2, 1024})).clamp_min(0.0);
   return st.denormalize_x(result);
 }

@@ -1,7 +1,8 @@
 // Runs independent jobs on plain threads: job(i) for i in [0, n) on `threads` threads
 // (the calling thread is one of them). The first exception stops the handing out of new
 // jobs and is rethrown after all threads have joined. For coarse jobs (a file, a sequence);
-// libtorch's own parallel_for is for loops inside one.
+// libtorch's own parallel_for is for loops inside one. With several workers each runs
+// libtorch and OpenBLAS on one OpenMP thread, so the workers do not oversubscribe the cores.
 #pragma once
 
 #include <cstddef>
