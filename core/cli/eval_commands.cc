@@ -23,6 +23,7 @@
 #include "core/cli/sequence_files.h"
 #include "core/io/sequence.h"
 #include "core/metrics/hand_vertices.h"
+#include "core/metrics/metrics_json.h"
 #include "core/metrics/multimodality.h"
 #include "core/metrics/sequence_metrics.h"
 #include "core/object/object_cache.h"
@@ -40,14 +41,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct SetResult {
-  std::string label, folder;
-  std::vector<std::string> files;
-  std::vector<SequenceMetrics> sequences;
-  std::vector<double> mul;  // per trajectory with >= 2 samples
-  size_t trajectories = 0;
-  std::vector<MetricResult> table;
-  std::vector<std::pair<std::string, std::string>> skipped;  // --keep-going: file, why
+struct SetResult : MetricsSet {
+  std::string label;
 };
 
 SequenceData sequence_data(const Sequence& s, bool keypoints) {
@@ -167,36 +162,6 @@ void print_table(const std::vector<SetResult>& sets) {
                              s.skipped.empty() ? "" : fmt::format("; {} files skipped (bad input)", s.skipped.size()));
 }
 
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json to_json(const SetResult& s) {
-  nlohmann::json j;
-  j["folder"] = s.folder;
-  j["sequences"] = s.sequences.size();
-  j["trajectories"] = s.trajectories;
-  j["trajectories_with_samples"] = s.mul.size();
-  j["skipped"] = nlohmann::json::array();
-  for (const auto& [file, why] : s.skipped) j["skipped"].push_back({{"file", file}, {"error", why}});
-  for (const auto& m : s.table) {
-    nlohmann::json c{{"name", m.name}, {"value", number(m.value)}, {"unit", m.unit},
-                     {"higher_is_better", m.higher_is_better}, {"num_sequences", m.num_sequences}};
-    if (m.frame_share) {
-      c["numerator"] = m.numerator;
-      c["denominator"] = m.denominator;
-    }
-    j["metrics"].push_back(c);
-  }
-  for (size_t i = 0; i < s.sequences.size(); ++i) {
-    const SequenceMetrics& m = s.sequences[i];
-    auto count = [](const FrameCount& c) { return nlohmann::json::array({c.hits, c.frames}); };
-    j["per_sequence"].push_back({{"file", s.files[i]}, {"name", m.name}, {"frames", m.frames},
-                                 {"accel_cm", number(100 * m.accel)}, {"pen_1cm", count(m.pen_1cm)},
-                                 {"pen_5mm", count(m.pen_5mm)}, {"con", count(m.contact)},
-                                 {"art", count(m.articulation)}, {"cm_cm", number(100 * m.contact_map)}});
-  }
-  return j;
-}
-
 struct EvalOptions {
   std::string folder, ground_truth, split, json, mano_left, mano_right;
   bool keep_going = false;
@@ -222,7 +187,7 @@ int eval(const EvalOptions& o) {
     nlohmann::json j;
     j["threads"] = threads;
     if (!o.split.empty()) j["split"] = o.split;
-    for (const auto& s : sets) j[s.label == "generated" ? "generated" : "ground_truth"] = to_json(s);
+    for (const auto& s : sets) j[s.label == "generated" ? "generated" : "ground_truth"] = metrics_json(s);
     write_file_atomically(o.json, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
     std::cout << "wrote " << o.json << "\n";
   }

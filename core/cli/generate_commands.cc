@@ -24,6 +24,7 @@
 #include "core/metrics/hand_vertices.h"
 #include "core/pipeline/graph.h"
 #include "core/pipeline/registry.h"
+#include "core/pipeline/stage.h"
 #include "core/pipeline/runner.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
@@ -96,6 +97,15 @@ int run_generate(const GenerateArgs& a) {
   if (trajectory_id.empty())
     throw Error(a.pipeline + ": bimart generate needs a trajectory.sequence stage to feed the windows to");
   if (exports.empty()) throw Error(a.pipeline + ": bimart generate needs at least one export.sequence stage");
+  // The samples: the pipeline's variable `samples` when it declares one, else the
+  // `samples` parameter of every stage that has one (the diffusion stages).
+  bool declares_samples_var = false;
+  for (const auto& v : proto.vars) declares_samples_var |= v.name == "samples";
+  std::vector<std::string> sampling_ids;
+  if (!declares_samples_var)
+    for (const auto& st : proto.stages)
+      if (const StageEntry* e = Registry::global().find(st.use); e && e->spec.find_param("samples"))
+        sampling_ids.push_back(st.id);
 
   // The evaluation windows, written with their ground truth.
   const fs::path out(a.out);
@@ -144,32 +154,37 @@ int run_generate(const GenerateArgs& a) {
   double residual_sum = 0;
   std::int64_t residual_count = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  ProgressBar bar("generate", windows.size() * static_cast<std::size_t>(a.samples), true);
+  ProgressBar bar("generate", windows.size(), true);
   for (const auto& w : windows) {
     nlohmann::json jw{{"name", w.name}, {"category", w.category}, {"start", w.start}, {"frames", w.length},
                       {"ground_truth", fs::relative(w.source, out).string()}};
-    for (int k = 0; k < a.samples; ++k) {
-      GraphFile file = proto;
-      for (const auto& o : a.overrides) file.apply_override(o);
-      file.apply_override(trajectory_id + ".path=" + w.source);
-      const std::string stem = fs::path(w.source).stem().string() + fmt::format("_s{:02d}", k);
-      for (const auto& e : exports) file.apply_override(e + ".path=" + (out / e / (stem + ".npz")).string());
-      file.seed = static_cast<std::uint64_t>(a.seed) + static_cast<std::uint64_t>(k);
-      const Graph g = validate(file, Registry::global());
-      const RunResult r = run_graph(g);
-      if (!motion_id.empty() && !fit_id.empty()) {
-        // Keypoint-to-MANO residual: generated H against the fitted hands' keypoints.
-        const at::Tensor X = r.context.get<at::Tensor>(motion_id + ".hand_keypoints");
-        const at::Tensor states = r.context.get<at::Tensor>(trajectory_id + ".object_states");
-        const at::Tensor H = hand_features_to_world(X, states).positions;  // [2, N, J, 3]
-        const at::Tensor fitted = hand_keypoints(r.context.get<HandMotion>(fit_id + ".hand_params"));
-        const double res = (H - fitted).norm(2, -1).mean().item<double>();
+    // One run per window draws all its samples as one batch; each export.sequence stage
+    // writes one file per sample (stages/samples.h).
+    GraphFile file = proto;
+    if (declares_samples_var) file.set_var("samples", std::to_string(a.samples), "--samples");
+    for (const auto& id : sampling_ids) file.apply_override(id + ".samples=" + std::to_string(a.samples));
+    for (const auto& o : a.overrides) file.apply_override(o);
+    file.apply_override(trajectory_id + ".path=" + w.source);
+    const std::string stem = fs::path(w.source).stem().string();
+    for (const auto& e : exports)
+      file.apply_override(e + ".path=" + (out / e / (stem + "_s{sample:02d}.npz")).string());
+    file.seed = static_cast<std::uint64_t>(a.seed);
+    const Graph g = validate(file, Registry::global());
+    const RunResult r = run_graph(g);
+    if (!motion_id.empty() && !fit_id.empty()) {
+      // Keypoint-to-MANO residual per sample: generated H against the fitted hands' keypoints.
+      const at::Tensor X = r.context.get<at::Tensor>(motion_id + ".hand_keypoints_samples");
+      const at::Tensor states = r.context.get<at::Tensor>(trajectory_id + ".object_states");
+      const auto& fits = r.context.get<std::vector<HandMotion>>(fit_id + ".hand_samples");
+      for (std::size_t k = 0; k < fits.size(); ++k) {
+        const at::Tensor H = hand_features_to_world(X[static_cast<std::int64_t>(k)], states).positions;  // [2, N, J, 3]
+        const double res = (H - hand_keypoints(fits[k])).norm(2, -1).mean().item<double>();
         jw["fit_residual_mm"].push_back(1e3 * res);
         residual_sum += res;
         ++residual_count;
       }
-      bar.step();
     }
+    bar.step();
     summary["windows"].push_back(jw);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -201,7 +216,7 @@ void add_generate_commands(CLI::App& app, Commands& out) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--window", a.window, "frames per window")->check(CLI::Range(2, 100000));
   cmd->add_option("--set", a.overrides, "override a parameter: stage.param=value (repeatable)");
-  cmd->add_option("--seed", a.seed, "seed of sample 0 (sample k uses seed + k)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--seed", a.seed, "seed of every window's run (its samples are drawn as one batch)")->check(CLI::NonNegativeNumber);
   out.push_back({cmd, [] { return run_generate(a); }});
 }
 

@@ -23,6 +23,9 @@ namespace {
 // Reads the pipeline, applies overrides, loads the libraries it names, validates it.
 Graph load_graph(const PipelineArgs& args) {
   GraphFile file = GraphFile::load(args.pipeline);
+  for (const auto& v : args.vars) file.set_var(v);
+  if (!args.out.empty()) file.set_var("out", args.out, "--out " + args.out);
+  if (args.samples > 0) file.set_var("samples", std::to_string(args.samples), "--samples " + std::to_string(args.samples));
   for (const auto& o : args.overrides) file.apply_override(o);
   if (args.has_seed) file.seed = args.seed;
   for (const auto& [lib, where] : file.plugins) {
@@ -61,9 +64,15 @@ int run(const PipelineArgs& args) {
   const RunResult result = run_graph(g, options);
   double total = 0;
   for (const auto& t : result.timings) total += t.seconds;
-  for (const auto& n : g.nodes)
-    if (const PortSpec* p = n.entry->spec.find_output("path"); p && p->type == type_name<std::string>())
+  // Each file written: a stage's `paths` (several files, e.g. one per sample), else its `path`.
+  for (const auto& n : g.nodes) {
+    if (const PortSpec* p = n.entry->spec.find_output("paths"); p && p->type == type_name<std::vector<std::string>>()) {
+      for (const auto& file : result.context.get<std::vector<std::string>>(n.id + ".paths"))
+        std::cout << "wrote " << file << "\n";
+    } else if (const PortSpec* q = n.entry->spec.find_output("path"); q && q->type == type_name<std::string>()) {
       std::cout << "wrote " << result.context.get<std::string>(n.id + ".path") << "\n";
+    }
+  }
   log::info("done in {:.2f} s", total);
   return 0;
 }
@@ -148,6 +157,10 @@ void add_pipeline_commands(CLI::App& app, Commands& out) {
   auto add_pipeline_args = [&](CLI::App* cmd) {
     cmd->add_option("pipeline", pa.pipeline, "pipeline YAML file")->required()->check(CLI::ExistingFile);
     cmd->add_option("--set", pa.overrides, "override a parameter: stage.param=value (repeatable)");
+    cmd->add_option("--var", pa.vars, "set a pipeline variable (vars:): name=value (repeatable)");
+    cmd->add_option("--out", pa.out, "output folder: sets the variable 'out'");
+    cmd->add_option("--samples", pa.samples, "samples generated at once: sets the variable 'samples'")
+        ->check(CLI::Range(1, 1024));
     add_seed_option(cmd, pa.seed, "override the pipeline's seed")->each([](const std::string&) { pa.has_seed = true; });
   };
 

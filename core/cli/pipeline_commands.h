@@ -11,6 +11,9 @@ namespace bimart::cli {
 struct PipelineArgs {
   std::string pipeline;
   std::vector<std::string> overrides;  // stage.param=value
+  std::vector<std::string> vars;       // name=value (--var)
+  std::string out;                     // --out: the variable `out`, when given
+  int samples = 0;                     // --samples: the variable `samples`, when > 0
   std::uint64_t seed = 0;              // with has_seed; else the pipeline's own
   bool has_seed = false;
 };

@@ -3,12 +3,16 @@
 //   name: smoke
 //   seed: 0
 //   plugins: [../build/libmy_stage.so]     # optional, relative to this file
+//   vars:                                  # optional: name: default (a YAML value;
+//     out: out/smoke                       #   empty = must be given with --var)
+//     frames: 64
 //   stages:
 //     - id: trajectory                     # unique, [a-z_][a-z0-9_]*
 //       use: trajectory.constant           # registered implementation
-//       params: {frames: 64}
-//     - id: write
+//       params: {frames: "${frames}"}   # a whole-value ${name} keeps the value's type
+//     - id: write                          # (here an int); inside text it is spliced in
 //       use: export.states_csv
+//       params: {path: "${out}/states.csv"}
 //       inputs: {object_states: trajectory.object_states}   # optional: by default an
 //                                           # input comes from the nearest earlier stage
 //                                           # with an output of the same name
@@ -34,6 +38,14 @@ struct ParamSetting {
   SourceLocation where;
 };
 
+// A pipeline variable (`vars:`), referred to as ${name} in parameter values.
+struct VarSetting {
+  std::string name;
+  YAML::Node value;     // the default, or the value given with --var; null: none yet
+  SourceLocation where;  // of the default, or the --var that set it
+  bool set = false;      // given on the command line
+};
+
 struct InputSetting {
   std::string port;
   std::string source;  // "stage_id.output"
@@ -55,6 +67,7 @@ struct GraphFile {
   std::string description;
   std::uint64_t seed = 0;
   std::vector<std::pair<std::string, SourceLocation>> plugins;  // resolved against the file's folder
+  std::vector<VarSetting> vars;
   std::vector<StageSetting> stages;
 
   static GraphFile load(const std::string& path);
@@ -66,6 +79,18 @@ struct GraphFile {
   // "seed=N". Unknown stages are reported here; unknown parameters at validation, with
   // the override as their location.
   void apply_override(const std::string& assignment);
+
+  // Sets a variable declared under vars: from "name=value" (value in YAML). `origin` names
+  // where it comes from in messages (e.g. "--var out=x", "--out"). A name the file does
+  // not declare is an error naming the file, with close names.
+  void set_var(const std::string& name, const std::string& value, const std::string& origin);
+  void set_var(const std::string& assignment);  // "name=value", as --var gives it
+
+  // `value` with every ${name} replaced: a scalar that is exactly "${name}" becomes the
+  // variable's value (keeping its YAML type), "${a}/x" splices the value's text in,
+  // "$${" stands for a literal "${"; lists and maps are substituted item by item.
+  // Throws bimart::Error (without location) for an undeclared name or one with no value.
+  YAML::Node substitute(const YAML::Node& value) const;
 };
 
 struct Binding {
@@ -89,6 +114,7 @@ struct Graph {
   std::string name;
   std::string description;
   std::uint64_t seed = 0;
+  std::vector<std::pair<std::string, std::string>> vars;  // name, value (YAML text)
   std::vector<GraphNode> nodes;  // in run order (dependencies first, then file order)
 
   const GraphNode& node(const std::string& id) const;

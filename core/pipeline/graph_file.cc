@@ -98,7 +98,7 @@ GraphFile GraphFile::parse(const std::string& text, const std::string& path,
   check_duplicate_keys(text, path);
   const Reader r(path);
   if (!root.IsMap()) throw Error(SourceLocation{path, 1, 1}, "a pipeline must be a mapping with a 'stages' list");
-  r.only_keys(root, {"name", "description", "seed", "plugins", "stages"}, "the pipeline");
+  r.only_keys(root, {"name", "description", "seed", "plugins", "vars", "stages"}, "the pipeline");
 
   GraphFile g;
   g.path = path;
@@ -117,6 +117,15 @@ GraphFile GraphFile::parse(const std::string& text, const std::string& path,
       fs::path lib = r.scalar(p, "a plug-in path");
       if (lib.is_relative() && !base_dir.empty()) lib = fs::path(base_dir) / lib;
       g.plugins.emplace_back(lib.lexically_normal().string(), at(path, p));
+    }
+  }
+  if (const YAML::Node vars = root["vars"]) {
+    if (!vars.IsMap()) r.fail(vars, "'vars' must be a mapping of variable names to default values");
+    for (const auto& kv : vars) {
+      const std::string name = r.scalar(kv.first, "a variable name");
+      if (!is_lower_identifier(name))
+        r.fail(kv.first, "variable name '" + name + "' must be lower case letters, digits and '_'");
+      g.vars.push_back({name, kv.second, at(path, kv.second.IsNull() ? kv.first : kv.second), false});
     }
   }
   const YAML::Node stages = root["stages"];
@@ -167,6 +176,80 @@ void GraphFile::apply_override(const std::string& assignment) {
   }
   throw Error(where, "no stage '" + stage_id + "' in " + path + did_you_mean(stage_id, ids) +
                          "; stages: " + join(ids, ", "));
+}
+
+void GraphFile::set_var(const std::string& name, const std::string& value, const std::string& origin) {
+  const SourceLocation where{origin, 0, 0};
+  std::vector<std::string> names;
+  for (auto& v : vars) {
+    names.push_back(v.name);
+    if (v.name != name) continue;
+    try {
+      v.value = YAML::Load(value);
+    } catch (const YAML::Exception& e) {
+      throw Error(where, "value is not valid YAML: " + e.msg);
+    }
+    v.where = where;
+    v.set = true;
+    return;
+  }
+  throw Error(where, path + " has no variable '" + name + "'" + did_you_mean(name, names) +
+                         (names.empty() ? "; it declares none (vars:)" : "; its variables: " + join(names, ", ")));
+}
+
+void GraphFile::set_var(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error(SourceLocation{"--var " + assignment, 0, 0}, "a variable must be set as name=value");
+  set_var(assignment.substr(0, eq), assignment.substr(eq + 1), "--var " + assignment);
+}
+
+YAML::Node GraphFile::substitute(const YAML::Node& value) const {
+  if (value.IsSequence() || value.IsMap()) {
+    YAML::Node out = YAML::Clone(value);
+    if (value.IsSequence())
+      for (std::size_t i = 0; i < value.size(); ++i) out[i] = substitute(value[i]);
+    else
+      for (auto kv : out) kv.second = substitute(kv.second);
+    return out;
+  }
+  if (!value.IsScalar() || value.Scalar().find('$') == std::string::npos) return value;
+  const std::string& text = value.Scalar();
+  auto lookup = [&](const std::string& name) -> const VarSetting& {
+    std::vector<std::string> names;
+    for (const auto& v : vars) {
+      if (v.name == name) {
+        if (v.value.IsNull())
+          throw Error("variable '" + name + "' has no value: give it with --var " + name + "=VALUE");
+        return v;
+      }
+      names.push_back(v.name);
+    }
+    throw Error("'${" + name + "}' names no variable of " + path + did_you_mean(name, names) +
+                (names.empty() ? "; declare it under vars:" : "; its variables: " + join(names, ", ")));
+  };
+  // The whole value is one variable: keep its YAML value (an int stays an int).
+  if (text.size() > 3 && text.compare(0, 2, "${") == 0 && text.back() == '}' &&
+      text.find('}') == text.size() - 1)
+    return YAML::Clone(lookup(text.substr(2, text.size() - 3)).value);
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text.compare(i, 3, "$${") == 0) {
+      out += "${";
+      i += 2;
+    } else if (text.compare(i, 2, "${") == 0) {
+      const auto end = text.find('}', i);
+      if (end == std::string::npos) throw Error("'" + text + "': '${' without its closing '}'");
+      const VarSetting& v = lookup(text.substr(i + 2, end - i - 2));
+      if (!v.value.IsScalar())
+        throw Error("variable '" + v.name + "' is a list or mapping; it can only stand alone, not inside '" + text + "'");
+      out += v.value.Scalar();
+      i = end;
+    } else {
+      out += text[i];
+    }
+  }
+  return YAML::Node(out);
 }
 
 }  // namespace bimart

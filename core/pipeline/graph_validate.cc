@@ -128,14 +128,23 @@ Graph validate(const GraphFile& file, const Registry& registry) {
                                   (names.empty() ? "; it takes none" : "; it takes: " + join(names, ", ")));
         continue;
       }
+      const SourceLocation w = p.value.Mark().line >= 0 && p.where.line > 0
+                                   ? SourceLocation{p.where.file, p.value.Mark().line + 1,
+                                                    p.value.Mark().column + 1}
+                                   : p.where;
+      YAML::Node value;
       try {
-        n.params.set(p.name, convert(p.value, ps->type));
+        value = file.substitute(p.value);
+      } catch (const Error& e) {
+        problems.add(w, describe_stage(s) + " parameter '" + p.name + "': " + e.message());
+        continue;
+      }
+      try {
+        n.params.set(p.name, convert(value, ps->type));
       } catch (const std::runtime_error& e) {
-        const SourceLocation w = p.value.Mark().line >= 0 && p.where.line > 0
-                                     ? SourceLocation{p.where.file, p.value.Mark().line + 1,
-                                                      p.value.Mark().column + 1}
-                                     : p.where;
-        problems.add(w, describe_stage(s) + " parameter '" + p.name + "' " + e.what());
+        const bool substituted = value.IsScalar() && p.value.IsScalar() && value.Scalar() != p.value.Scalar();
+        problems.add(w, describe_stage(s) + " parameter '" + p.name + "' " + e.what() +
+                            (substituted ? " (from '" + p.value.Scalar() + "')" : ""));
       }
     }
   }
@@ -276,6 +285,7 @@ Graph validate(const GraphFile& file, const Registry& registry) {
   g.name = file.name;
   g.description = file.description;
   g.seed = file.seed;
+  for (const auto& v : file.vars) g.vars.emplace_back(v.name, v.value.IsNull() ? "" : YAML::Dump(v.value));
   for (std::size_t i : order) g.nodes.push_back(std::move(nodes[i]));
   return g;
 }
@@ -289,6 +299,11 @@ const GraphNode& Graph::node(const std::string& id) const {
 std::string Graph::describe() const {
   std::string s = "pipeline '" + name + "' (" + path + "), seed " + std::to_string(seed) + "\n";
   if (!description.empty()) s += "  " + description + "\n";
+  if (!vars.empty()) {
+    std::vector<std::string> parts;
+    for (const auto& [name, value] : vars) parts.push_back(name + " = " + (value.empty() ? "(none)" : value));
+    s += "  vars: " + join(parts, ", ") + "\n";
+  }
   int k = 0;
   for (const auto& n : nodes) {
     const StageSpec& spec = n.entry->spec;

@@ -1,4 +1,5 @@
-// export.html: the viewer page for one sequence (core/export/viewer_page.h).
+// export.html: the viewer page (core/export/viewer_page.h), with every sample of the run
+// (stages/samples.h) on one page.
 #include <filesystem>
 
 #include "core/export/gltf_scene.h"
@@ -27,19 +28,26 @@ class HtmlExport : public Exporter {
   }
   void run(StageIO& io) override {
     const std::string name = name_.empty() ? std::filesystem::path(path_).stem().string() : name_;
-    const SceneSource src = outputs_plugin::scene_from_inputs(io, hands_, name);
+    const std::vector<StageSample> samples = stage_samples(io);
     GltfOptions o;
     o.correctives = correctives_;
-    ViewerSample sample;
-    sample.name = name;
-    sample.fps = src.sequence.fps;
-    sample.frames = src.sequence.num_frames();
-    sample.glb = build_glb(src.sequence, src.object, src.models(), o);
-    sample.contacts = viewer_contacts(src.sequence);
-    sample.top_vertices = src.object.top.num_vertices();
-    const auto bytes = write_viewer_page({sample}, name, path_);
-    log::info("{}: {:.2f} MB", path_, bytes / 1e6);
+    std::vector<ViewerSample> pages;
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const std::string sample_name = samples.size() == 1 ? name : "sample " + std::to_string(k);
+      const SceneSource src = outputs_plugin::scene_from_inputs(io, hands_, sample_name, samples[k]);
+      ViewerSample sample;
+      sample.name = sample_name;
+      sample.fps = src.sequence.fps;
+      sample.frames = src.sequence.num_frames();
+      sample.glb = build_glb(src.sequence, src.object, src.models(), o);
+      sample.contacts = viewer_contacts(src.sequence);
+      sample.top_vertices = src.object.top.num_vertices();
+      pages.push_back(std::move(sample));
+    }
+    const auto bytes = write_viewer_page(pages, name, path_);
+    log::info("{}: {} sample{}, {:.2f} MB", path_, pages.size(), pages.size() == 1 ? "" : "s", bytes / 1e6);
     io.out("path", path_);
+    io.out("paths", std::vector<std::string>{path_});
   }
 
  private:

@@ -1,5 +1,6 @@
 // The inputs export.gltf and export.html share: the refined hands, the object and its
-// trajectory, optional contact maps, and the hand models that pose the hands.
+// trajectory, optional contact maps, every sample (stages/samples.h), and the hand models
+// that pose the hands.
 #pragma once
 
 #include <memory>
@@ -9,6 +10,7 @@
 
 #include "core/export/scene_source.h"
 #include "core/pipeline/plugin.h"
+#include "stages/samples.h"
 
 namespace bimart::outputs_plugin {
 
@@ -23,18 +25,20 @@ inline void declare_scene_inputs(StageSpec& s) {
       .param("mano_left", "", "left hand model .npz (empty: the shipped hand; give both or neither)")
       .param("mano_right", "", "right hand model .npz (the models the hands were made with)")
       .param("name", "", "sequence name shown in the file (default: the file's stem)");
+  declare_sample_ports(s);
 }
 
+// The scene of one sample (stage_samples(io)).
 inline SceneSource scene_from_inputs(StageIO& io, const std::shared_ptr<const std::array<HandModel, 2>>& hands,
-                                     const std::string& name) {
+                                     const std::string& name, const StageSample& sample) {
   SceneSource src;
   src.sequence.name = name;
   src.sequence.object = io.has("object_path") ? io.in<std::string>("object_path") : "(from the pipeline)";
   src.sequence.fps = io.in<double>("fps");
   src.sequence.object_states = io.in<at::Tensor>("object_states");
-  src.sequence.hands = io.in<HandMotion>("hand_params");
-  if (io.has("contact_maps") && io.has("basis_hit_indices")) {
-    src.sequence.contact_maps = io.in<at::Tensor>("contact_maps");
+  src.sequence.hands = *sample.hands;
+  if (sample.contact_maps.defined() && io.has("basis_hit_indices")) {
+    src.sequence.contact_maps = sample.contact_maps.contiguous();
     src.sequence.basis_hit_indices = io.in<at::Tensor>("basis_hit_indices");
   }
   src.object = io.in<ArticulatedObject>("object");

@@ -9,6 +9,7 @@
 #include "core/refine/refinement.h"
 #include "core/util/log.h"
 #include "hand_models.h"
+#include "samples.h"
 #include "stages/refiner.h"
 
 namespace bimart {
@@ -53,22 +54,27 @@ class CeresRefineStage : public Refiner {
   }
 
   void run(StageIO& io) override {
-    const at::Tensor& X = io.in<at::Tensor>("hand_keypoints");
     const at::Tensor& states = io.in<at::Tensor>("object_states");
-    const ArticulatedObject& object = io.in<ArticulatedObject>("object");
+    const ObjectDistance distance(io.in<ArticulatedObject>("object"));  // built once, shared by the samples
     const auto models = hands_->pointers();
-    HandMotion start;
-    if (io.has("hand_params")) {
-      start = io.in<HandMotion>("hand_params");
-    } else {
-      log::info("refine.ceres: no hand_params to start from; fitting MANO first (refine.mano_fit's defaults)");
-      start = fit_mano(models, hand_features_to_world(X, states).positions);
-    }
-    const ObjectDistance distance(object);
-    RefineReport report;
-    HandMotion motion = refine_hands(models, distance, states, X, start, o_, &report);
-    log::info("refine.ceres: {} frames in {:.2f} s\n{}", X.size(0), report.seconds, format_refine_report(report));
-    io.out("hand_params", std::move(motion));
+    refine_plugin::refine_samples(io, o_.threads, [&](std::size_t k, const at::Tensor& X, const HandMotion* given, int threads) {
+      HandMotion start;
+      if (given) {
+        start = *given;
+      } else {
+        log::info("refine.ceres: no hand_params to start from; fitting MANO first (refine.mano_fit's defaults)");
+        ManoFitOptions fit;
+        fit.threads = threads;
+        start = fit_mano(models, hand_features_to_world(X, states).positions, fit);
+      }
+      RefineOptions o = o_;
+      o.threads = threads;
+      RefineReport report;
+      HandMotion motion = refine_hands(models, distance, states, X, start, o, &report);
+      log::info("refine.ceres: {} frames in {:.2f} s (sample {})\n{}", X.size(0), report.seconds, k,
+                format_refine_report(report));
+      return motion;
+    });
   }
 
  private:

@@ -7,6 +7,7 @@
 #include "core/refine/mano_fit.h"
 #include "core/util/log.h"
 #include "hand_models.h"
+#include "samples.h"
 #include "stages/refiner.h"
 
 namespace bimart {
@@ -40,13 +41,17 @@ class ManoFitStage : public Refiner {
   }
 
   void run(StageIO& io) override {
-    const at::Tensor& X = io.in<at::Tensor>("hand_keypoints");
     const at::Tensor& states = io.in<at::Tensor>("object_states");
-    ManoFitReport report;
-    HandMotion motion = fit_mano(hands_->pointers(), hand_features_to_world(X, states).positions, o_, &report);
-    log::info("mano_fit: {} frames, mean keypoint error {:.2f} / {:.2f} mm (left / right), {:.2f} s", X.size(0),
-              1e3 * report.hands[0].mean_keypoint_error, 1e3 * report.hands[1].mean_keypoint_error, report.seconds);
-    io.out("hand_params", std::move(motion));
+    refine_plugin::refine_samples(io, o_.threads, [&](std::size_t k, const at::Tensor& X, const HandMotion*, int threads) {
+      ManoFitOptions o = o_;
+      o.threads = threads;
+      ManoFitReport report;
+      HandMotion motion = fit_mano(hands_->pointers(), hand_features_to_world(X, states).positions, o, &report);
+      log::info("mano_fit: {} frames, mean keypoint error {:.2f} / {:.2f} mm (left / right), {:.2f} s (sample {})",
+                X.size(0), 1e3 * report.hands[0].mean_keypoint_error, 1e3 * report.hands[1].mean_keypoint_error,
+                report.seconds, k);
+      return motion;
+    });
   }
 
  private:

@@ -294,3 +294,109 @@ TEST(Graph, PluginPathsResolveAgainstTheFilesFolder) {
   EXPECT_EQ(f.plugins[1].first, "/abs/b.so");
   EXPECT_EQ(f.plugins[0].second.line, 1);
 }
+
+// Pipeline variables (vars:, ${name}, --var).
+namespace {
+const char* kVars = R"(vars:
+  value: 2.5
+  out: out/x
+  label: hello
+stages:
+  - id: src
+    use: test.source
+    params: {value: "${value}"}
+  - id: text
+    use: test.text
+  - id: sink
+    use: test.sink
+    params: {}
+)";
+
+GraphFile vars_file(const std::string& yaml = kVars) { return GraphFile::parse(yaml, "test.yaml"); }
+}  // namespace
+
+TEST(GraphVars, WholeValueKeepsTheTypeAndTextIsSpliced) {
+  GraphFile f = vars_file();
+  EXPECT_DOUBLE_EQ(validate(f, registry()).node("src").params.number("value"), 2.5);
+  const YAML::Node spliced = f.substitute(YAML::Node("${out}/a_${label}.npz"));
+  EXPECT_EQ(spliced.Scalar(), "out/x/a_hello.npz");
+  EXPECT_EQ(f.substitute(YAML::Node("cost $$5 and $${out}")).Scalar(), "cost $$5 and ${out}");
+  EXPECT_EQ(f.substitute(YAML::Load("[\"${out}\", 2]"))[0].Scalar(), "out/x");
+  f.set_var("value=4");  // as --var value=4
+  const Graph g = validate(f, registry());
+  EXPECT_DOUBLE_EQ(g.node("src").params.number("value"), 4.0);
+  EXPECT_HAS(g.describe(), "vars: value = 4, out = out/x, label = hello");
+}
+
+TEST(GraphVars, OverridesMaySubstituteToo) {
+  GraphFile f = vars_file();
+  f.apply_override("src.value=${value}");
+  f.set_var("value", "7", "--samples 7");
+  EXPECT_DOUBLE_EQ(validate(f, registry()).node("src").params.number("value"), 7.0);
+}
+
+TEST(GraphVars, UnknownVariableOnTheCommandLineIsAnErrorWithCloseNames) {
+  GraphFile f = vars_file();
+  try {
+    f.set_var("valeu=3");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_HAS(e.what(), "--var valeu=3");
+    EXPECT_HAS(e.what(), "test.yaml has no variable 'valeu'");
+    EXPECT_HAS(e.what(), "did you mean 'value'");
+    EXPECT_HAS(e.what(), "its variables: value, out, label");
+  }
+  GraphFile none = GraphFile::parse("stages:\n  - {id: src, use: test.source}\n", "plain.yaml");
+  try {
+    none.set_var("out", "x", "--out x");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_HAS(e.what(), "plain.yaml has no variable 'out'; it declares none");
+  }
+  EXPECT_THROW(f.set_var("novalue"), Error);
+}
+
+TEST(GraphVars, UndeclaredVariableNamesTheFileAndLine) {
+  const std::string m = error_of(R"(vars:
+  value: 1
+stages:
+  - id: src
+    use: test.source
+    params:
+      value: ${vlue}
+)");
+  EXPECT_HAS(m, "test.yaml:7:14:");
+  EXPECT_HAS(m, "stage 'src' parameter 'value'");
+  EXPECT_HAS(m, "'${vlue}' names no variable of test.yaml (did you mean 'value'?)");
+}
+
+TEST(GraphVars, VariableWithoutValueMustBeGiven) {
+  const char* yaml = R"(vars:
+  value:
+stages:
+  - id: src
+    use: test.source
+    params: {value: "${value}"}
+)";
+  EXPECT_HAS(error_of(yaml), "variable 'value' has no value: give it with --var value=VALUE");
+  GraphFile f = vars_file(yaml);
+  f.set_var("value=1.5");
+  EXPECT_DOUBLE_EQ(validate(f, registry()).node("src").params.number("value"), 1.5);
+}
+
+TEST(GraphVars, BadValuesAndNames) {
+  // A value of the wrong type says where it came from.
+  GraphFile f = vars_file();
+  f.set_var("value=abc");
+  try {
+    validate(f, registry());
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_HAS(e.what(), "test.yaml:8:21: stage 'src' parameter 'value' expects a float, got 'abc' (from '${value}')");
+  }
+  EXPECT_HAS(error_of("vars: {Bad: 1}\nstages:\n  - {id: src, use: test.source}\n"),
+             "variable name 'Bad' must be lower case");
+  EXPECT_HAS(error_of("vars: [a]\nstages:\n  - {id: src, use: test.source}\n"), "'vars' must be a mapping");
+  EXPECT_HAS(error_of("vars: {v: 1}\nstages:\n  - {id: src, use: test.source, params: {value: \"${v\"}}\n"),
+             "without its closing '}'");
+}
