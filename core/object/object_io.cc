@@ -14,6 +14,7 @@
 
 #include "core/geometry/rotation.h"
 #include "core/object/families/families.h"
+#include "core/object/part_checks.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
@@ -41,26 +42,6 @@ Eigen::Vector3d read_vec3(const std::string& file, const YAML::Node& n, const st
   }
   if (!v.allFinite()) throw Error(where(file, n), field + " holds a non-finite number");
   return v;
-}
-
-// A closed part must enclose a volume and sit at the hinge; measured after closing.
-void check_part_shape(const TriangleMesh& m, const std::string& path) {
-  if (m.num_faces() < kMinPartFaces)
-    throw Error(fmt::format("{}: the part has {} faces once closed; a solid part needs at least {} (is it a single "
-                            "sheet or triangle?)",
-                            path, m.num_faces(), kMinPartFaces));
-  const double r = bounding_radius(m);
-  const double volume = signed_volume(m);
-  if (!(volume > kMinPartVolumeRatio * r * r * r))
-    throw Error(fmt::format("{}: the part encloses {:.3g} m³ once closed, about zero for its size (radius {:.3g} "
-                            "m): a flat or inside-out mesh is no solid part",
-                            path, volume, r));
-  const Eigen::Vector3d lo = m.vertices.colwise().minCoeff(), hi = m.vertices.colwise().maxCoeff();
-  const double gap = lo.cwiseMax(-hi).cwiseMax(0.0).norm();  // box to the hinge point (origin)
-  if (gap > kMaxHingeGapRatio * r + kMinPartRadius)
-    throw Error(fmt::format("{}: the part is {:.3g} m from the hinge (its nearest point; its radius is {:.3g} m): "
-                            "parts must touch the hinge; check hinge.pivot and units",
-                            path, gap, r));
 }
 
 // Reads, checks, scales to metres, moves to the canonical frame, closes and orients a part.
@@ -103,6 +84,25 @@ void category_defaults(ArticulatedObject& o) {
 }
 
 }  // namespace
+
+void check_part_shape(const TriangleMesh& m, const std::string& path) {
+  if (m.num_faces() < kMinPartFaces)
+    throw Error(fmt::format("{}: the part has {} faces once closed; a solid part needs at least {} (is it a single "
+                            "sheet or triangle?)",
+                            path, m.num_faces(), kMinPartFaces));
+  const double r = bounding_radius(m);
+  const double volume = signed_volume(m);
+  if (!(volume > kMinPartVolumeRatio * r * r * r))
+    throw Error(fmt::format("{}: the part encloses {:.3g} m³ once closed, about zero for its size (radius {:.3g} "
+                            "m): a flat or inside-out mesh is no solid part",
+                            path, volume, r));
+  const Eigen::Vector3d lo = m.vertices.colwise().minCoeff(), hi = m.vertices.colwise().maxCoeff();
+  const double gap = lo.cwiseMax(-hi).cwiseMax(0.0).norm();  // box to the hinge point (origin)
+  if (gap > kMaxHingeGapRatio * r + kMinPartRadius)
+    throw Error(fmt::format("{}: the part is {:.3g} m from the hinge (its nearest point; its radius is {:.3g} m): "
+                            "parts must touch the hinge; check hinge.pivot and units",
+                            path, gap, r));
+}
 
 std::string ObjectLoadReport::str() const { return "top: " + top.str() + "; bottom: " + bottom.str(); }
 

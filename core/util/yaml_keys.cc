@@ -3,12 +3,14 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/exceptions.h>
 #include <yaml-cpp/parser.h>
+#include <yaml-cpp/yaml.h>
 
 #include <map>
 #include <sstream>
 #include <vector>
 
 #include "core/util/error.h"
+#include "core/util/text.h"
 
 namespace bimart {
 namespace {
@@ -78,6 +80,24 @@ void check_duplicate_keys(const std::string& text, const std::string& file) {
     parser.HandleNextDocument(handler);
   } catch (const YAML::Exception&) {
     // Syntax errors: the caller's YAML::Load reports them with their own position.
+  }
+}
+
+SourceLocation yaml_location(const std::string& file, const YAML::Node& node) {
+  const YAML::Mark m = node.Mark();
+  return {file, m.line >= 0 ? m.line + 1 : 0, m.column >= 0 ? m.column + 1 : 0};
+}
+
+void check_known_keys(const YAML::Node& node, const std::vector<std::string>& known, const std::string& file,
+                      const std::string& what) {
+  if (!node.IsMap()) return;
+  for (const auto& kv : node) {
+    const std::string key = kv.first.Scalar();
+    bool found = false;
+    for (const std::string& k : known) found = found || k == key;
+    if (!found)
+      throw Error(yaml_location(file, kv.first),
+                  "unknown key '" + key + "' in " + what + did_you_mean(key, known) + " (known: " + join(known, ", ") + ")");
   }
 }
 
