@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include <fmt/format.h>
+
 #include "core/io/npz.h"
 #include "core/util/error.h"
 
@@ -33,6 +35,18 @@ void check_finite(const char* name, const M& m) {
   if (!m.allFinite()) throw Error(std::string("hand model: ") + name + " has NaN or infinite values");
 }
 
+// A finite but absurd value (1e30 in a template) would make every posed vertex NaN or inf
+// far downstream; the bounds are generous for any real hand model (MANO: template within
+// 0.15 m, blend shapes under 0.05 m per unit, PCA components orthonormal).
+template <class M>
+void check_bounded(const char* name, const M& m, double bound, const char* unit) {
+  Eigen::Index r = 0, c = 0;
+  const double worst = m.cwiseAbs().maxCoeff(&r, &c);
+  if (worst > bound)
+    throw Error(fmt::format("hand model: {} has the value {:g} at [{}, {}], beyond the bound of {:g} {} for a hand model",
+                            name, m(r, c), r, c, bound, unit));
+}
+
 }  // namespace
 
 int HandModel::num_vertices() const { return static_cast<int>(v_template.rows()); }
@@ -58,6 +72,12 @@ void HandModel::validate() const {
   check_finite("weights", weights);
   check_finite("hands_components", hands_components);
   check_finite("hands_mean", hands_mean);
+  check_bounded("v_template", v_template, 2.0, "m");
+  check_bounded("shapedirs", shapedirs, 1.0, "m per unit of shape");
+  check_bounded("posedirs", posedirs, 1.0, "m per unit of pose feature");
+  check_bounded("J_regressor", j_regressor, 10.0, "(regression weight)");
+  check_bounded("hands_components", hands_components, 10.0, "rad");
+  check_bounded("hands_mean", hands_mean, 2 * M_PI, "rad");
 
   for (Eigen::Index v = 0; v < V; ++v) {
     const double sum = weights.row(v).sum();

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <vector>
 
+#include "core/object/ply_file.h"
 #include "core/util/error.h"
 
 namespace bimart {
@@ -152,99 +153,6 @@ void check_off(const Checker& c, std::istream& in) {
   }
 }
 
-int ply_type_size(const std::string& type) {
-  static const std::pair<const char*, int> sizes[] = {
-      {"char", 1}, {"uchar", 1}, {"int8", 1}, {"uint8", 1}, {"short", 2}, {"ushort", 2}, {"int16", 2},
-      {"uint16", 2}, {"int", 4}, {"uint", 4}, {"int32", 4}, {"uint32", 4}, {"float", 4}, {"float32", 4},
-      {"double", 8}, {"float64", 8}};
-  for (const auto& [name, size] : sizes)
-    if (type == name) return size;
-  return 0;
-}
-
-void check_ply(const Checker& c, std::istream& in) {
-  long n = 0;
-  std::string line;
-  if (!std::getline(in, line)) c.fail(0, "the file is empty");
-  ++n;
-  if (line.rfind("ply", 0) != 0) c.fail(1, "the first line must be 'ply'");
-  struct Element {
-    std::string name;
-    long count = 0;
-    double min_bytes = 0;  // per element
-    std::vector<std::string> props;
-  };
-  std::vector<Element> elements;
-  std::string format;
-  bool ended = false;
-  while (std::getline(in, line)) {
-    ++n;
-    c.text_only(line, n, "PLY header");
-    const auto t = tokens(line);
-    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
-    if (t[0] == "end_header") {
-      ended = true;
-      break;
-    }
-    if (t[0] == "format") {
-      if (t.size() < 2) c.fail(n, "'format' needs ascii, binary_little_endian or binary_big_endian");
-      format = t[1];
-      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-        c.fail(n, "unknown PLY format '" + format + "'");
-    } else if (t[0] == "element") {
-      if (t.size() < 3) c.fail(n, "'element' needs a name and a count");
-      elements.push_back({t[1], c.integer(t[2], n, "element count"), 0, {}});
-      if (elements.back().count < 0) c.fail(n, "negative element count");
-    } else if (t[0] == "property") {
-      if (elements.empty()) c.fail(n, "'property' before any 'element'");
-      Element& e = elements.back();
-      const bool list = t.size() >= 2 && t[1] == "list";
-      if (list && t.size() < 5) c.fail(n, "'property list' needs the count type, item type and name");
-      const int size = ply_type_size(list ? t[2] : (t.size() >= 2 ? t[1] : ""));
-      if (size == 0 || (!list && t.size() < 3)) c.fail(n, "unknown property type in '" + line.substr(0, 60) + "'");
-      e.min_bytes += format == "ascii" ? 2 : size;  // a list holds at least its count
-      e.props.push_back(t.back());
-    } else {
-      c.fail(n, "unknown PLY header line '" + line.substr(0, 60) + "'");
-    }
-  }
-  if (!ended) c.fail(n, "the header never ends ('end_header' missing)");
-  if (format.empty()) c.fail(n, "the header has no 'format' line");
-  long vertices = -1, faces = -1;
-  for (const Element& e : elements) {
-    c.count_fits(n, (e.name + " elements").c_str(), e.count, std::max(e.min_bytes, 1.0));
-    if (e.name == "vertex") vertices = e.count;
-    if (e.name == "face") faces = e.count;
-  }
-  if (vertices <= 0) c.fail(n, "the header declares no vertices");
-  if (faces <= 0) c.fail(n, "the header declares no faces");
-  if (format != "ascii") return;
-  // ascii body: coordinates finite, face indices in range.
-  std::vector<std::string> t;
-  for (const Element& e : elements) {
-    const auto find = [&](const char* p) {
-      return static_cast<long>(std::find(e.props.begin(), e.props.end(), p) - e.props.begin());
-    };
-    for (long i = 0; i < e.count; ++i) {
-      if (!next_tokens(in, n, t, c, "PLY")) c.fail(n, fmt::format("ends after {} of {} {} elements", i, e.count, e.name));
-      if (e.name == "vertex") {
-        for (const char* axis : {"x", "y", "z"}) {
-          const long k = find(axis);
-          if (k < static_cast<long>(t.size())) c.number(t[static_cast<size_t>(k)], n, "vertex coordinate");
-        }
-      } else if (e.name == "face" && e.props.size() == 1) {
-        const long k = c.integer(t[0], n, "corner count");
-        if (k < 3) c.fail(n, fmt::format("a face needs at least 3 corners, this one has {}", k));
-        if (static_cast<long>(t.size()) < k + 1) c.fail(n, fmt::format("the face lists {} of {} corners", t.size() - 1, k));
-        for (long j = 1; j <= k; ++j) {
-          const long id = c.integer(t[static_cast<size_t>(j)], n, "face index");
-          if (id < 0 || id >= vertices) c.fail(n, fmt::format("face index {} is out of range [0, {})", id, vertices));
-        }
-      }
-    }
-  }
-}
-
 void check_stl(const Checker& c, std::istream& in) {
   if (c.size() == 0) c.fail(0, "the file is empty");
   char head[84] = {};
@@ -300,7 +208,7 @@ void check_mesh_file(const std::string& path) {
   if (size == 0) c.fail(0, "the file is empty");
   if (ext == ".obj") check_obj(c, in);
   else if (ext == ".off") check_off(c, in);
-  else if (ext == ".ply") check_ply(c, in);
+  else if (ext == ".ply") read_ply_file(path);  // the reader itself checks (core/object/ply_file.h)
   else if (ext == ".stl") check_stl(c, in);
   else c.fail(0, "unknown mesh format '" + ext + "' (supported: .obj, .ply, .off, .stl)");
 }

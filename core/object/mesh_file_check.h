@@ -1,4 +1,4 @@
-// A pass over a mesh file before CGAL reads it. CGAL's reader answers every fault with
+// A pass over a mesh file before CGAL reads it (PLY: our own reader, core/object/ply_file.h). CGAL's reader answers every fault with
 // `false` (and allocates whatever a header declares), so this names the fault and its line
 // — empty file, binary bytes in a text format, a coordinate that is no finite number, a face
 // index out of range (OBJ counts from 1), no vertices or faces, a header declaring more

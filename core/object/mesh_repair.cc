@@ -9,7 +9,9 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "core/object/mesh_file_check.h"
+#include "core/object/ply_file.h"
 #include "core/util/error.h"
 
 namespace bimart {
@@ -28,6 +31,7 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Mesh = CGAL::Surface_mesh<Point>;
 namespace PMP = CGAL::Polygon_mesh_processing;
+namespace fs = std::filesystem;
 
 TriangleMesh from_surface_mesh(Mesh& sm) {
   sm.collect_garbage();
@@ -77,16 +81,24 @@ int orient_components_outward(TriangleMesh& m) {
 }  // namespace
 
 TriangleMesh read_mesh_file(const std::string& path) {
-  check_mesh_file(path);  // names the fault and the line; bounds what headers declare
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
-  bool ok = false;
-  try {
-    ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
-  } catch (const std::exception& e) {
-    throw Error(path + ": cannot read mesh: " + e.what());
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  if (ext == ".ply") {  // our reader: CGAL's crashed on fuzzed PLY files (core/object/ply_file.h)
+    PlyMesh ply = read_ply_file(path);
+    for (const auto& v : ply.vertices) points.emplace_back(v[0], v[1], v[2]);
+    for (const auto& f : ply.faces) polygons.emplace_back(f.begin(), f.end());
+  } else {
+    check_mesh_file(path);  // names the fault and the line; bounds what headers declare
+    bool ok = false;
+    try {
+      ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
+    } catch (const std::exception& e) {
+      throw Error(path + ": cannot read mesh: " + e.what());
+    }
+    if (!ok) throw Error(path + ": cannot read mesh (supported: .obj, .ply, .off, .stl)");
   }
-  if (!ok) throw Error(path + ": cannot read mesh (supported: .obj, .ply, .off, .stl)");
   TriangleMesh m;
   m.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
   for (std::size_t i = 0; i < points.size(); ++i)

@@ -19,6 +19,13 @@ ply = ('ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty floa
        'element face 4\nproperty list uchar int vertex_indices\nend_header\n'
        + ''.join(f'{x} {y} {z}\n' for x, y, z in tet_v) + ''.join(f'3 {a} {b} {d}\n' for a, b, d in tet_f))
 open(c + 'mesh/tetra.ply.bin', 'wb').write(b'\x02' + ply.encode())
+for order, fmt in (('little', '<'), ('big', '>')):  # binary PLY with extra properties (core/object/ply_file.cc)
+    head = (f'ply\nformat binary_{order}_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n'
+            'property float z\nproperty uchar flag\nelement face 4\nproperty uchar red\n'
+            'property list uchar int vertex_indices\nend_header\n').encode()
+    body = b''.join(struct.pack(fmt + '3fB', *v, 7) for v in tet_v)
+    body += b''.join(struct.pack(fmt + 'BB3i', 0, 3, *f) for f in tet_f)
+    open(c + f'mesh/tetra_{order}.ply.bin', 'wb').write(b'\x02' + head + body)
 stl = bytearray(b'bimart fuzz seed'.ljust(80, b' ')) + struct.pack('<I', 4)
 for f in tet_f:
     stl += struct.pack('<3f', 0, 0, 0)

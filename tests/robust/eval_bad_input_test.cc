@@ -89,6 +89,33 @@ TEST(EvalBadInput, HandModelWithoutOneHundredKeypointsIsRefusedAsByRefine) {
   EXPECT_NE(f.output.find("has 50 keypoints"), std::string::npos) << f.output;
 }
 
+TEST(EvalBadInput, HandModelWithAHugeFiniteValueIsRefusedByName) {
+  ScratchDir dir("eval_model_bounds");
+  test::write_box(dir);
+  write_sequence(test::hover_sequence("a"), dir / "gen/a.npz");
+  // A finite 1e30 in the model's own template: it loaded, and every posed vertex became inf.
+  const std::string right = find_data_file("models/hand/mano_right.npz");
+  NpzFile npz = NpzFile::read(find_data_file("models/hand/mano_left.npz"));
+  NpyArray a = npz.get("v_template");
+  ASSERT_EQ(a.item_size(), 8);  // float64
+  const double huge = 1e30;
+  std::memcpy(a.data.data() + 8 * (3 * 5 + 1), &huge, 8);  // vertex 5, y
+  npz.set("v_template", a);
+  const std::string left = dir / "mano_left.npz";
+  npz.write(left);
+  try {
+    load_hand_model(left);
+    ADD_FAILURE() << "a template vertex at 1e30 m was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("v_template has the value 1e+30 at [5, 1], beyond the bound"),
+              std::string::npos) << e.what();
+  }
+  const auto r = run_bimart("eval " + (dir / "gen") + " --threads 1 --mano-left " + left + " --mano-right " + right);
+  EXPECT_EQ(exit_code(r.status), 1) << r.output;
+  EXPECT_NE(r.output.find("mano_left.npz"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("beyond the bound"), std::string::npos) << r.output;
+}
+
 TEST(EvalBadInput, MissingObjectNamesTheSequence) {
   ScratchDir dir("eval_object");
   Sequence s = test::hover_sequence("lost");

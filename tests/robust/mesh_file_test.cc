@@ -2,8 +2,11 @@
 // line, instead of one "cannot read mesh"; headers cannot make the reader allocate at will.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <string>
+#include <vector>
 
 #include "core/object/mesh_repair.h"
 #include "core/util/error.h"
@@ -86,6 +89,71 @@ TEST(MeshFiles, PlyAndStlHeadersAreChecked) {
   std::memcpy(&stl[80], &count, 4);
   EXPECT_EQ(read_error(dir, "huge.stl", stl),
             p + "huge.stl: the header declares 100000000 triangles (5000000084 bytes), but the file has 84 bytes");
+}
+
+// Binary PLY, as our reader reads it (CGAL's crashed on fuzzed PLY files): both byte
+// orders give the same tetrahedron; extra properties are read past; a negative or oversized
+// list count, a truncated body and a missing face list each name their fault.
+std::string binary_ply(bool big, const std::string& face_props, const std::string& body_faces, int vertices = 4) {
+  std::string s = std::string("ply\nformat binary_") + (big ? "big" : "little") + "_endian 1.0\nelement vertex " +
+                  std::to_string(vertices) + "\nproperty float x\nproperty float y\nproperty float z\n" +
+                  "property uchar flag\nelement face 4\n" + face_props + "end_header\n";
+  const float v[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int i = 0; i < vertices; ++i) {
+    for (float x : v[i]) {
+      char b[4];
+      std::memcpy(b, &x, 4);
+      if (big) std::reverse(b, b + 4);
+      s.append(b, 4);
+    }
+    s.push_back('\x07');  // flag
+  }
+  return s + body_faces;
+}
+
+std::string faces_u8_i32(bool big, const std::vector<std::vector<std::int32_t>>& faces, char extra = 0) {
+  std::string s;
+  for (const auto& f : faces) {
+    s.push_back(extra);
+    s.push_back(static_cast<char>(f.size()));
+    for (std::int32_t id : f) {
+      char b[4];
+      std::memcpy(b, &id, 4);
+      if (big) std::reverse(b, b + 4);
+      s.append(b, 4);
+    }
+  }
+  return s;
+}
+
+TEST(MeshFiles, BinaryPlyInBothByteOrdersAndItsFaults) {
+  ScratchDir dir("ply_binary");
+  const std::string p = dir / "";
+  const std::vector<std::vector<std::int32_t>> tetra = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  const std::string props = "property uchar red\nproperty list uchar int vertex_indices\n";
+  for (bool big : {false, true}) {
+    const std::string name = big ? "be.ply" : "le.ply";
+    EXPECT_EQ(read_error(dir, name, binary_ply(big, props, faces_u8_i32(big, tetra))), "");
+    const TriangleMesh m = read_mesh_file(dir / name);
+    ASSERT_EQ(m.num_vertices(), 4);
+    ASSERT_EQ(m.num_faces(), 4);
+    EXPECT_EQ(m.vertices(3, 2), 1.0);
+    EXPECT_EQ(m.faces(3, 1), 2);
+  }
+  EXPECT_EQ(read_error(dir, "range.ply", binary_ply(false, props, faces_u8_i32(false, {{0, 2, 1}, {0, 1, 9}}))),
+            p + "range.ply: byte 284: face index 9 is out of range [0, 4)");
+  EXPECT_EQ(read_error(dir, "short.ply", binary_ply(false, props, faces_u8_i32(false, {{0, 2, 1}}))),
+            p + "short.ply: byte 274: the file ends where a number was expected (truncated)");
+  // A signed count of -1: CGAL would size a list from it.
+  const std::string signed_props = "property uchar red\nproperty list char int vertex_indices\n";
+  std::string neg = faces_u8_i32(false, tetra);
+  neg[1] = '\xff';
+  EXPECT_EQ(read_error(dir, "negative.ply", binary_ply(false, signed_props, neg)),
+            p + "negative.ply: byte 260: a list of -1 items does not fit in the rest of the file");
+  EXPECT_EQ(read_error(dir, "nolist.ply", binary_ply(false, "property list uchar int corners\n", faces_u8_i32(false, tetra))),
+            p + "nolist.ply:8: the faces have no list property 'vertex_indices' (or 'vertex_index')");
+  EXPECT_EQ(read_error(dir, "floatcount.ply", binary_ply(false, "property list float int vertex_indices\n", "")),
+            p + "floatcount.ply:9: a list's count type must be an integer type, not 'float'");
 }
 
 }  // namespace
