@@ -199,7 +199,13 @@ void write_sequence(const Sequence& s, const std::string& path) {
 std::string relative_object_path(const std::string& object_path, const std::string& sequence_path) {
   namespace fs = std::filesystem;
   const fs::path folder = fs::absolute(fs::path(sequence_path)).parent_path();
-  return fs::relative(fs::absolute(object_path), folder).string();
+  const fs::path object = fs::absolute(object_path).lexically_normal();
+  const fs::path rel = fs::relative(object, folder);
+  // Near the file (a data set's ../objects/x): relative, so the folders move together.
+  // Farther (an object cache in the home folder): absolute, so copying the file keeps it.
+  int ups = 0;
+  for (const auto& part : rel) ups += part == "..";
+  return rel.empty() || ups > 2 ? object.string() : rel.string();
 }
 
 std::string resolve_object_path(const Sequence& sequence, const std::string& sequence_path) {

@@ -42,8 +42,8 @@ Sequence read_sequence(const std::string& path);
 void write_sequence(const Sequence& sequence, const std::string& path);
 // The object path resolved against the sequence file's folder.
 std::string resolve_object_path(const Sequence& sequence, const std::string& sequence_path);
-// The inverse: `object_path` as a Sequence stores it for a file at `sequence_path`
-// (relative to that file's folder).
+// The inverse: `object_path` as a Sequence stores it for a file at `sequence_path`:
+// relative to that file's folder when at most two `..` lead there, else absolute.
 std::string relative_object_path(const std::string& object_path, const std::string& sequence_path);
 
 }  // namespace bimart
