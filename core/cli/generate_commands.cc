@@ -173,7 +173,10 @@ int run_generate(const GenerateArgs& a) {
     const RunResult r = run_graph(g);
     if (!motion_id.empty() && !fit_id.empty()) {
       // Keypoint-to-MANO residual per sample: generated H against the fitted hands' keypoints.
-      const at::Tensor X = r.context.get<at::Tensor>(motion_id + ".hand_keypoints_samples");
+      // A motion stage that knows nothing of samples (motion.ground_truth) writes one.
+      const std::string key = motion_id + ".hand_keypoints";
+      const at::Tensor X = r.context.has(key + "_samples") ? r.context.get<at::Tensor>(key + "_samples")
+                                                            : r.context.get<at::Tensor>(key).unsqueeze(0);
       const at::Tensor states = r.context.get<at::Tensor>(trajectory_id + ".object_states");
       const auto& fits = r.context.get<std::vector<HandMotion>>(fit_id + ".hand_samples");
       for (std::size_t k = 0; k < fits.size(); ++k) {

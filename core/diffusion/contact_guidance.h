@@ -6,7 +6,8 @@
 // correction, so H + D (the surface point each keypoint refers to) stays put.
 //
 // The gradient is analytic (only the nearest keypoint of each object point carries it),
-// not autograd: nearest keypoints by one batched matrix product per hand.
+// not autograd: nearest keypoints by brute force over the J keypoints, frames and hands in
+// parallel, with no temporaries (core/diffusion/contact_guidance.cc).
 #pragma once
 
 #include <cstdint>

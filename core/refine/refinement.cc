@@ -395,6 +395,21 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         problem.AddResidualBlock(new AccelCost(d, t, blocks, rows), nullptr, p);
       }
     }
+    // Bounds keep a hand that the penetration boost pushes hard from winding its joints
+    // round and round (generated keypoints 5 cm deep once drove a finger angle to 1,100 rad):
+    // each finger axis-angle component within ±π, the root's within ±2π.
+    for (int64_t t = 0; t < d->N; ++t) {
+      double* x = d->x.data() + t * kX;
+      for (const Block& b : blocks_of(0x1f)) {
+        if (b.offset == 48 || !problem.HasParameterBlock(x + b.offset)) continue;  // translation: free
+        const double bound = b.offset == 0 ? 2 * M_PI : M_PI;
+        for (int i = 0; i < b.size; ++i) {
+          x[b.offset + i] = std::clamp(x[b.offset + i], -bound, bound);
+          problem.SetParameterLowerBound(x + b.offset, i, -bound);
+          problem.SetParameterUpperBound(x + b.offset, i, bound);
+        }
+      }
+    }
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     so.max_num_iterations = o.max_iterations;
