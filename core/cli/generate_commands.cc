@@ -3,8 +3,9 @@
 // sequence files that `bimart eval` groups by trajectory (docs/training.md, "Evaluation").
 //
 // The evaluation set: one window of `--window` frames (64) from the middle of every
-// sequence of the split, ordered round-robin over categories (so `--limit N` still covers
-// every category), each written with its ground-truth hands to DIR/ground_truth/.
+// sequence of the split, ordered round-robin over categories and within them over the kinds
+// (so `--limit N` still covers every category and both kinds), each written with its
+// ground-truth hands to DIR/ground_truth/.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -59,15 +60,33 @@ HandMotion slice_hands(const HandMotion& m, std::int64_t start, std::int64_t len
   return out;
 }
 
-// Round-robin over categories (sorted), sequences by name within each.
-std::vector<std::string> category_order(const std::vector<std::pair<std::string, std::string>>& files) {
-  std::map<std::string, std::vector<std::string>> by;
-  for (const auto& [category, file] : files) by[category].push_back(file);
-  for (auto& [c, v] : by) std::sort(v.begin(), v.end());
+struct WindowSource {
+  std::string category, kind, file;
+};
+
+// Round-robin over categories (sorted); within each, round-robin over the kinds (grab,
+// use), sequences by name within each kind. So `--limit N` covers every category and, from
+// N = 2 × categories on, both kinds (the Art metric needs "use" windows).
+std::vector<std::string> category_order(const std::vector<WindowSource>& files) {
+  std::map<std::string, std::map<std::string, std::vector<std::string>>> by;  // category → kind → files
+  for (const auto& f : files) by[f.category][f.kind].push_back(f.file);
+  std::map<std::string, std::vector<std::string>> per_category;
+  for (auto& [c, kinds] : by) {
+    for (auto& [k, v] : kinds) std::sort(v.begin(), v.end());
+    for (std::size_t i = 0;; ++i) {
+      bool any = false;
+      for (auto& [k, v] : kinds)
+        if (i < v.size()) {
+          per_category[c].push_back(v[i]);
+          any = true;
+        }
+      if (!any) break;
+    }
+  }
   std::vector<std::string> order;
   for (std::size_t i = 0;; ++i) {
     bool any = false;
-    for (auto& [c, v] : by)
+    for (auto& [c, v] : per_category)
       if (i < v.size()) {
         order.push_back(v[i]);
         any = true;
@@ -110,11 +129,11 @@ int run_generate(const GenerateArgs& a) {
   // The evaluation windows, written with their ground truth.
   const fs::path out(a.out);
   const fs::path gt_dir = out / "ground_truth";
-  std::vector<std::pair<std::string, std::string>> by_category;
+  std::vector<WindowSource> by_category;
   std::map<std::string, Sequence> loaded;
   for (const auto& f : files) {
     Sequence s = read_sequence(f);
-    by_category.push_back({s.category, f});
+    by_category.push_back({s.category, s.kind, f});
     loaded[f] = std::move(s);
   }
   std::vector<std::string> order = category_order(by_category);
