@@ -6,6 +6,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BIMART_BUILD_DIR:-$root/build}
 mkdir -p "$build"
+# ccache keys on absolute paths unless told the tree's root: with it, another clone of the
+# repository (CI's clean clone, a worktree) reuses the objects this one compiled.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root}
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE="${BIMART_BUILD_TYPE:-Release}" "$@" > "$build/configure.log" 2>&1 \
   || { cat "$build/configure.log"; echo "build: CMake configure failed (log above)"; exit 1; }
