@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <map>
+#include <utility>
 #include <sstream>
 #include <vector>
 
@@ -44,7 +45,9 @@ class DuplicateKeys : public YAML::EventHandler {
 
   void open(bool map) {
     // A container used as a key or a value counts as one node of its parent when it closes.
-    stack_.push_back({map});
+    Level level;
+    level.map = map;
+    stack_.push_back(std::move(level));
   }
   void close() {
     stack_.pop_back();
