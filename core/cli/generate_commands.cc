@@ -64,36 +64,36 @@ struct WindowSource {
   std::string category, kind, file;
 };
 
+// The first of every list, then the second of every list, and so on.
+std::vector<std::string> round_robin(const std::vector<std::vector<std::string>>& lists) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0;; ++i) {
+    bool any = false;
+    for (const auto& v : lists)
+      if (i < v.size()) {
+        out.push_back(v[i]);
+        any = true;
+      }
+    if (!any) return out;
+  }
+}
+
 // Round-robin over categories (sorted); within each, round-robin over the kinds (grab,
 // use), sequences by name within each kind. So `--limit N` covers every category and, from
 // N = 2 × categories on, both kinds (the Art metric needs "use" windows).
 std::vector<std::string> category_order(const std::vector<WindowSource>& files) {
   std::map<std::string, std::map<std::string, std::vector<std::string>>> by;  // category → kind → files
   for (const auto& f : files) by[f.category][f.kind].push_back(f.file);
-  std::map<std::string, std::vector<std::string>> per_category;
+  std::vector<std::vector<std::string>> per_category;
   for (auto& [c, kinds] : by) {
-    for (auto& [k, v] : kinds) std::sort(v.begin(), v.end());
-    for (std::size_t i = 0;; ++i) {
-      bool any = false;
-      for (auto& [k, v] : kinds)
-        if (i < v.size()) {
-          per_category[c].push_back(v[i]);
-          any = true;
-        }
-      if (!any) break;
+    std::vector<std::vector<std::string>> per_kind;
+    for (auto& [k, v] : kinds) {
+      std::sort(v.begin(), v.end());
+      per_kind.push_back(v);
     }
+    per_category.push_back(round_robin(per_kind));
   }
-  std::vector<std::string> order;
-  for (std::size_t i = 0;; ++i) {
-    bool any = false;
-    for (auto& [c, v] : per_category)
-      if (i < v.size()) {
-        order.push_back(v[i]);
-        any = true;
-      }
-    if (!any) break;
-  }
-  return order;
+  return round_robin(per_category);
 }
 
 int run_generate(const GenerateArgs& a) {
