@@ -30,4 +30,5 @@ void add_refine_commands(CLI::App& app, Commands& out);    // refine
 void add_train_commands(CLI::App& app, Commands& out);     // train
 void add_generate_commands(CLI::App& app, Commands& out);  // generate
 void add_export_commands(CLI::App& app, Commands& out);    // export, view, render
+void add_model_commands(CLI::App& app, Commands& out);     // model check
 }  // namespace bimart::cli

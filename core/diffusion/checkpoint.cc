@@ -72,6 +72,8 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   for (const auto& field : kIntFields)
     f.set(std::string("network/") + field.key, make_npy_scalar<std::int64_t>(i.network.*field.member));
   f.set("network/dropout", make_npy_scalar<double>(i.network.dropout));
+  set_string(f, "network/output", i.network.output);
+  f.set("network/skip_rank", make_npy_scalar<std::int64_t>(i.network.skip_rank));
   set_string(f, "diffusion/schedule", i.schedule);
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
   set_string(f, "encoder/variant", i.variant);
@@ -112,6 +114,13 @@ Checkpoint load_checkpoint(const std::string& path) {
     i.network.*field.member = static_cast<int>(v);
   }
   i.network.dropout = get_double(f, "network/dropout");
+  // Checkpoints from before the skip output predicted x0 directly.
+  i.network.output = f.contains("network/output") ? get_string(f, "network/output") : "x0";
+  if (f.contains("network/skip_rank")) {
+    const std::int64_t k = get_int(f, "network/skip_rank");
+    if (k < 1 || k > 65536) throw Error(f.where("network/skip_rank") + ": out of range");
+    i.network.skip_rank = static_cast<int>(k);
+  }
   try {
     i.network.validate();
   } catch (const Error& e) {

@@ -3,8 +3,10 @@
 #include <torch/nn/modules/activation.h>
 #include <torch/nn/modules/transformerlayer.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/diffusion/schedule.h"
 #include "core/util/error.h"
 
 namespace bimart::diffusion {
@@ -50,12 +52,51 @@ void DenoiserConfig::validate() const {
   require(feedforward >= 1, "feedforward", "must be positive");
   require(condition_hidden >= 1, "condition_hidden", "must be positive");
   require(dropout >= 0 && dropout < 1, "dropout", "must be in [0, 1)");
+  require(output == "x0" || output == "gaussian", "output", "must be x0 or gaussian, got '" + output + "'");
+  require(skip_rank >= 1 && skip_rank <= 65536, "skip_rank", "must be in [1, 65536]");
 }
 
 std::string DenoiserConfig::describe() const {
   return model + " denoiser: latent " + std::to_string(latent) + ", " + std::to_string(layers) +
          " layers, " + std::to_string(heads) + " heads, feed-forward " + std::to_string(feedforward) +
-         ", condition MLPs " + std::to_string(condition_hidden) + ", window " + std::to_string(window);
+         ", condition MLPs " + std::to_string(condition_hidden) + ", window " + std::to_string(window) +
+         (output == "gaussian" ? ", Gaussian skip of rank " + std::to_string(std::min(skip_rank, sample_size)) : "");
+}
+
+at::Tensor predict_x0(DenoiserImpl& net, const NoiseSchedule& schedule, const at::Tensor& x_t, const at::Tensor& t,
+                      const at::Tensor& cond) {
+  const at::Tensor out = net.forward(x_t, t, cond);
+  if (net.config().output == "x0") return out;
+  const at::Tensor abar = at::tensor(schedule.alphas_cumprod, at::kDouble).index_select(0, t.to(at::kLong));
+  const at::Tensor a = abar.to(x_t.scalar_type()).view({x_t.size(0), 1, 1});
+  const at::Tensor& U = net.skip_directions();
+  const at::Tensor lam = net.skip_variances().view({1, 1, -1});
+  const at::Tensor denom = a * lam + (1.0 - a);                                          // [B, 1, k]
+  const at::Tensor gain = a.sqrt() * lam / denom;
+  const at::Tensor rest = (lam * (1.0 - a) / denom).sum(-1, true).div(x_t.size(-1)).sqrt();  // [B, 1, 1]
+  return at::matmul(at::matmul(x_t, U) * gain, U.t()) + rest * out;
+}
+
+std::pair<at::Tensor, at::Tensor> principal_directions(const at::Tensor& samples, int k) {
+  if (samples.dim() != 2 || samples.size(0) < 1)
+    throw Error("principal directions: need samples [N, D], got " + c10::str(samples.sizes()));
+  const at::Tensor x = samples.to(at::kDouble);
+  const at::Tensor moment = at::matmul(x.t(), x) / static_cast<double>(x.size(0));
+  const auto [values, vectors] = at::linalg_eigh(moment);  // ascending
+  const int64_t D = x.size(1), n = std::min<int64_t>(k, D);
+  const at::Tensor top = at::arange(D - 1, D - 1 - n, -1, at::kLong);
+  return {vectors.index_select(1, top).to(at::kFloat).contiguous(),
+          values.index_select(0, top).clamp_min(0.0).to(at::kFloat).contiguous()};
+}
+
+void DenoiserImpl::set_gaussian_skip(const at::Tensor& directions, const at::Tensor& variances) {
+  if (!directions.sizes().equals(skip_directions_.sizes()) || !variances.sizes().equals(skip_variances_.sizes()))
+    throw Error("denoiser: Gaussian skip must be " + c10::str(skip_directions_.sizes()) + " and " +
+                c10::str(skip_variances_.sizes()) + ", got " + c10::str(directions.sizes()) + " and " +
+                c10::str(variances.sizes()));
+  torch::NoGradGuard ng;
+  skip_directions_.copy_(directions);
+  skip_variances_.copy_(variances);
 }
 
 at::Tensor timestep_embedding(const at::Tensor& t, int dim) {
@@ -93,6 +134,11 @@ DenoiserImpl::DenoiserImpl(const DenoiserConfig& config) : config_(config) {
   encoder_ = register_module(
       "encoder", torch::nn::TransformerEncoder(torch::nn::TransformerEncoderOptions(layer, config_.layers)));
   positions_ = register_buffer("positions", sinusoidal_positions(config_.window + 1, L));
+  if (config_.output == "gaussian") {
+    const int k = std::min(config_.skip_rank, config_.sample_size);
+    skip_directions_ = register_buffer("skip_directions", torch::eye(config_.sample_size, k));
+    skip_variances_ = register_buffer("skip_variances", torch::ones({k}));
+  }
 }
 
 at::Tensor DenoiserImpl::encode_conditions(const at::Tensor& object, const at::Tensor& contact,

@@ -3,7 +3,9 @@
 // MLP), sinusoidal positions, one linear layer in and one out, and per-frame condition
 // MLPs whose outputs are added to the frame tokens: the object condition [O | G] for both
 // models, and for the motion model the contact maps C or a learned per-frame null token.
-// The model predicts the clean sample x0 (normalised).
+// The model predicts the clean sample x0 (normalised), either as the network's output
+// ("x0") or as the best linear estimate from the noisy input plus the network's correction
+// ("gaussian", see DenoiserConfig::output and predict_x0).
 //
 // The condition MLPs do not depend on the step or the noisy sample, so they are encoded
 // once per sampling (encode_conditions) and reused by every denoising step (forward).
@@ -31,6 +33,16 @@ struct DenoiserConfig {
   int feedforward = 1024;
   int condition_hidden = 1024;     // width of the condition MLPs (input -> h -> h -> latent)
   double dropout = 0.1;
+  // "x0": the network's output F is the x0 prediction. "gaussian": x0 = S_t·x_t + c_t·F,
+  // where S_t is the optimal (Wiener) denoiser of Gaussian data with the training samples'
+  // covariance U·diag(λ)·Uᵀ (its top `skip_rank` directions, fitted before training):
+  // S_t = U·diag(√ᾱ λ / (ᾱ λ + 1 − ᾱ))·Uᵀ, and c_t² = Σ λ(1 − ᾱ)/(ᾱ λ + 1 − ᾱ) / D its mean
+  // remaining variance (Karras et al. 2022's c_skip/c_out with a covariance instead of one
+  // σ_data). At low noise x0 is then x_t projected onto the data, at high noise the
+  // network's. Experimental: S_t filters each frame alone, so the noise it lets through is
+  // white over time and samples flicker (docs/training.md, "Output").
+  std::string output = "x0";
+  int skip_rank = 256;  // directions of S_t (at most sample_size)
 
   // The configuration of a model kind with the paper's size (DESIGN §5).
   static DenoiserConfig paper(const std::string& model);
@@ -52,10 +64,16 @@ class DenoiserImpl : public torch::nn::Module {
   at::Tensor encode_conditions(const at::Tensor& object, const at::Tensor& contact = {},
                                const at::Tensor& use_contact = {});
 
-  // x0 prediction [B, T, sample]: x_t [B, T, sample], t [B] int64 steps, cond [B, T, latent].
+  // The network's output [B, T, sample] (x0 or F, see DenoiserConfig::output; predict_x0
+  // gives x0 for both): x_t [B, T, sample], t [B] int64 steps, cond [B, T, latent].
   at::Tensor forward(const at::Tensor& x_t, const at::Tensor& t, const at::Tensor& cond);
 
   const DenoiserConfig& config() const { return config_; }
+  // The Gaussian skip's directions U [sample, k] (orthonormal columns) and variances λ [k]
+  // (buffers, stored with the weights). Until set: the first k unit vectors, λ = 1.
+  void set_gaussian_skip(const at::Tensor& directions, const at::Tensor& variances);
+  const at::Tensor& skip_directions() const { return skip_directions_; }
+  const at::Tensor& skip_variances() const { return skip_variances_; }
   std::int64_t num_parameters() const;
 
  private:
@@ -65,8 +83,17 @@ class DenoiserImpl : public torch::nn::Module {
   torch::nn::TransformerEncoder encoder_{nullptr};
   at::Tensor null_contact_;  // [window, latent] parameter (motion model)
   at::Tensor positions_;     // [window + 1, latent] buffer: sinusoidal positions
+  at::Tensor skip_directions_, skip_variances_;  // "gaussian" output: [sample, k], [k] buffers
 };
 TORCH_MODULE(Denoiser);
+
+struct NoiseSchedule;
+// The x0 prediction of `net` (either output kind): x_t, t, cond as for forward.
+at::Tensor predict_x0(DenoiserImpl& net, const NoiseSchedule& schedule, const at::Tensor& x_t, const at::Tensor& t,
+                      const at::Tensor& cond);
+// The top k eigenvectors [D, k] and eigenvalues [k] (descending) of the second moment
+// XᵀX / N of samples X [N, D] (normalised data: mean ≈ 0), for set_gaussian_skip.
+std::pair<at::Tensor, at::Tensor> principal_directions(const at::Tensor& samples, int k);
 
 // Sinusoidal embedding [B, dim] of the steps t [B] (transformer style: sin then cos over
 // log-spaced frequencies from 1 to 1/10000).

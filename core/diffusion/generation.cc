@@ -165,7 +165,7 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   const auto agree = [&](const at::Tensor& x) { return K == 1 ? x : lay.split(lay.fuse(x)); };
   const auto predict = [&](const at::Tensor& x_t, int t) {
     const at::Tensor xin = cfg ? at::cat({x_t, x_t}, 0) : x_t;
-    const at::Tensor out = net_->forward(xin, at::full({xin.size(0)}, t, at::kLong), cond_emb);
+    const at::Tensor out = predict_x0(*net_, schedule_, xin, at::full({xin.size(0)}, t, at::kLong), cond_emb);
     at::Tensor x0 = cfg ? out.slice(0, 0, B) : out;
     if (guidance != nullptr && motion) {
       const at::Tensor metres = st.denormalize_x(x0);

@@ -208,13 +208,16 @@ TrainConfig load_train_config(const std::string& path) {
   read(path, root, "variant", c.variant);
   read(path, root, "stride", c.stride);
   if (const YAML::Node n = root["network"]) {
-    check_keys(path, n, "network", {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout"});
+    check_keys(path, n, "network",
+               {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank"});
     read(path, n, "latent", c.network.latent);
     read(path, n, "layers", c.network.layers);
     read(path, n, "heads", c.network.heads);
     read(path, n, "feedforward", c.network.feedforward);
     read(path, n, "condition_hidden", c.network.condition_hidden);
     read(path, n, "dropout", c.network.dropout);
+    read(path, n, "output", c.network.output);
+    read(path, n, "skip_rank", c.network.skip_rank);
   }
   if (const YAML::Node n = root["diffusion"]) {
     check_keys(path, n, "diffusion", {"schedule", "steps"});
@@ -303,12 +306,33 @@ StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stat
 LossParts step_loss(Denoiser& net, const NoiseSchedule& schedule, const StepInputs& in) {
   const at::Tensor x_t = add_noise(schedule, in.sample, in.noise, in.t);
   const at::Tensor cond = net->encode_conditions(in.object, in.contact, in.use_contact);
-  const at::Tensor pred = net->forward(x_t, in.t, cond);
+  const at::Tensor pred = predict_x0(*net, schedule, x_t, in.t, cond);
   const at::Tensor err = (pred - in.sample).pow(2).mean(-1);  // [B, T]
   LossParts lp;
   lp.sum = (err * in.mask).sum();
   lp.frames = in.mask.sum().item<double>();
   return lp;
+}
+
+// The Gaussian skip's directions (DenoiserConfig::output) from the normalised samples of up
+// to 1024 windows spread evenly over the train split (deterministic).
+static std::pair<at::Tensor, at::Tensor> fit_gaussian_skip(const TrainConfig& c, const NormalizationStats& stats,
+                                                    const WindowDataset& data) {
+  const std::int64_t n = std::min<std::int64_t>(1024, static_cast<std::int64_t>(data.size()));
+  std::vector<at::Tensor> rows;
+  for (std::int64_t first = 0; first < n; first += 128) {
+    std::vector<std::int64_t> idx;
+    for (std::int64_t i = first; i < std::min(n, first + 128); ++i)
+      idx.push_back(i * static_cast<std::int64_t>(data.size()) / n);
+    const WindowBatch b = data.batch(idx);
+    const at::Tensor x = c.model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2)
+                                              : stats.normalize_x(b.hand_features);
+    rows.push_back(x.reshape({-1, x.size(-1)}).index_select(0, at::nonzero(b.mask.reshape({-1}) > 0).squeeze(1)));
+  }
+  auto fit = principal_directions(at::cat(rows, 0), c.network.skip_rank);
+  log::info("Gaussian skip: {} directions hold {:.4f} of the samples' variance", fit.second.size(0),
+            fit.second.sum().item<double>() / static_cast<double>(c.network.sample_size));
+  return fit;
 }
 
 StepInputs draw_step(const TrainConfig& config, const NormalizationStats& stats, const WindowDataset& data,
@@ -399,6 +423,11 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   Denoiser net(config.network);
   Denoiser ema_net(config.network);
   load_state(*ema_net, state_of(*net), "EMA copy");
+  if (config.network.output == "gaussian") {
+    const auto [directions, variances] = fit_gaussian_skip(config, stats, train_set);
+    net->set_gaussian_skip(directions, variances);
+    ema_net->set_gaussian_skip(directions, variances);
+  }
   init_lock.unlock();
   ema_net->eval();
   torch::optim::Adam opt(net->parameters(), torch::optim::AdamOptions(config.lr).weight_decay(config.weight_decay));

@@ -145,6 +145,16 @@ TEST(Cli, HelpForEachCommand) {
   }
 }
 
+TEST(Cli, ModelCheckNamesAMissingCheckpointOrDataSet) {
+  EXPECT_EQ(bimart("model check --help").code, 0);
+  const Result none = bimart("model check /nonexistent/m.npz /nonexistent/data");
+  EXPECT_EQ(none.code, 1);
+  EXPECT_HAS(none.output, "/nonexistent/m.npz");
+  const Result data = bimart("model check " + std::string(BIMART_SOURCE_DIR) + "/models/contact.npz /nonexistent/data");
+  EXPECT_EQ(data.code, 1);
+  EXPECT_HAS(data.output, "/nonexistent/data");
+}
+
 TEST(Cli, EncodersRunInAPipelineWithTheirShippedBases) {
   const fs::path yaml = scratch("encoders.yaml");
   const fs::path out = scratch("encoders/states.csv");

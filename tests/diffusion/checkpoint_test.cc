@@ -30,9 +30,10 @@ NormalizationStats unit_stats() {
   return s;
 }
 
-Checkpoint tiny_checkpoint() {
+Checkpoint tiny_checkpoint(const std::string& output = "x0") {
   Checkpoint c;
   c.info.network = DenoiserConfig::paper("contact");
+  c.info.network.output = output;
   c.info.network.latent = 16;
   c.info.network.layers = 1;
   c.info.network.heads = 2;
@@ -79,6 +80,23 @@ TEST(Checkpoint, RoundTripKeepsWeightsAndInfo) {
   EXPECT_FALSE(r.train.has_value());
   const Denoiser net = make_denoiser(r, path);
   for (const auto& p : net->named_parameters()) EXPECT_TRUE(at::equal(p.value(), c.weights.at(p.key())));
+}
+
+TEST(Checkpoint, OutputKindRoundTripsAndOlderFilesPredictX0) {
+  Checkpoint c = tiny_checkpoint("gaussian");
+  ASSERT_EQ(c.weights.count("skip_directions"), 1u);
+  const std::string path = scratch("gaussian.npz");
+  save_checkpoint(c, path);
+  EXPECT_EQ(load_checkpoint(path).info.network.output, "gaussian");
+  // A checkpoint written before the output kind existed has no network/output: it was x0.
+  const NpzFile f = NpzFile::read(path);
+  NpzFile older;
+  for (const auto& key : f.keys())
+    if (key != "network/output" && key != "network/skip_rank" && key.find("skip_") == std::string::npos)
+      older.set(key, f.get(key));
+  const std::string old_path = scratch("older.npz");
+  older.write(old_path, NpzCompression::Store);
+  EXPECT_EQ(load_checkpoint(old_path).info.network.output, "x0");
 }
 
 TEST(Checkpoint, MismatchesNameWhatDiffers) {

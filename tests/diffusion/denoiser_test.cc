@@ -7,6 +7,7 @@
 #include <ATen/ATen.h>
 
 #include "core/diffusion/denoiser.h"
+#include "core/diffusion/schedule.h"
 #include "core/util/error.h"
 
 namespace bimart::diffusion {
@@ -74,6 +75,71 @@ TEST(Denoiser, OverfitsATinyBatch) {
   }
   EXPECT_GT(first, 0.5);
   EXPECT_LT(last, 0.02 * first) << "first " << first << ", last " << last;
+}
+
+// Before any training, the Gaussian skip (unit variances until fitted) already recovers the
+// data at the least noisy step (x0 ≈ √ᾱ x_t up to √(1−ᾱ_0) ≈ 0.04 times the network's
+// output), where the network that outputs x0 directly is as far off as the data's spread;
+// at the noisiest step (ᾱ ≈ 0) the prediction is the network's output alone.
+TEST(Denoiser, GaussianSkipRecoversTheDataAtLowNoiseBeforeTraining) {
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const at::Tensor x0 = at::randn({3, 8, 12}), obj = at::randn({3, 8, 10});
+  const auto error_at = [&](const std::string& output, int step) {
+    torch::manual_seed(4);
+    DenoiserConfig c = tiny("contact");
+    c.output = output;
+    Denoiser net(c);
+    torch::NoGradGuard ng;
+    const at::Tensor t = at::full({3}, step, at::kLong);
+    const at::Tensor xt = add_noise(s, x0, at::randn(x0.sizes()), t);
+    const at::Tensor cond = net->encode_conditions(obj);
+    const at::Tensor pred = predict_x0(*net, s, xt, t, cond);
+    if (step == 49 && output == "gaussian")
+      EXPECT_TRUE(at::allclose(pred, net->forward(xt, t, cond), 0.0, 0.02));  // ᾱ_49 ≈ 1e-5
+    return (pred - x0).pow(2).mean().item<double>();
+  };
+  EXPECT_LT(error_at("gaussian", 0), 0.01);
+  EXPECT_GT(error_at("x0", 0), 0.5);
+  EXPECT_GT(error_at("gaussian", 49), 0.5);
+  DenoiserConfig bad = tiny("contact");
+  bad.output = "eps";
+  EXPECT_THROW(bad.validate(), Error);
+}
+
+// With the network's output at zero, the fitted Gaussian skip is the Wiener filter: for
+// data in a 2-dimensional subspace of 12 (variances 8 and 4) its error at every step is
+// the closed form Σ λ(1−ᾱ)/(ᾱλ + 1 − ᾱ) / D, and the subspace and variances are recovered
+// from samples.
+TEST(Denoiser, FittedGaussianSkipIsTheWienerFilter) {
+  torch::manual_seed(5);
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const at::Tensor basis = std::get<0>(at::linalg_qr(at::randn({12, 2}, at::kDouble))).to(at::kFloat);
+  const at::Tensor lambda = at::tensor({8.0f, 4.0f});
+  const auto draw = [&](int64_t n) { return at::matmul(at::randn({n, 2}) * lambda.sqrt(), basis.t()); };
+  const auto [dirs, vars] = principal_directions(draw(40000), 2);
+  EXPECT_NEAR(vars[0].item<double>(), 8.0, 0.25);
+  EXPECT_NEAR(vars[1].item<double>(), 4.0, 0.15);
+  EXPECT_NEAR(at::matmul(dirs.t(), basis).abs().sum().item<double>(), 2.0, 0.02);  // same plane
+
+  DenoiserConfig c = tiny("contact");
+  c.output = "gaussian";
+  c.skip_rank = 2;
+  Denoiser net(c);
+  net->set_gaussian_skip(dirs, vars);
+  torch::NoGradGuard ng;
+  for (auto& p : net->named_parameters())
+    if (p.key().rfind("output.", 0) == 0) p.value().zero_();
+  const at::Tensor x0 = draw(4 * 8 * 500).view({4 * 500, 8, 12});
+  const at::Tensor cond = net->encode_conditions(at::randn({x0.size(0), 8, 10}));
+  for (int step : {0, 10, 25, 40, 49}) {
+    const double a = s.alphas_cumprod[step];
+    const at::Tensor t = at::full({x0.size(0)}, step, at::kLong);
+    const at::Tensor xt = add_noise(s, x0, at::randn(x0.sizes()), t);
+    const double err = (predict_x0(*net, s, xt, t, cond) - x0).pow(2).mean().item<double>();
+    const double expected = (8 * (1 - a) / (a * 8 + 1 - a) + 4 * (1 - a) / (a * 4 + 1 - a)) / 12;
+    EXPECT_NEAR(err, expected, 0.05 * expected + 1e-4) << "step " << step;
+  }
+  EXPECT_THROW(net->set_gaussian_skip(at::randn({12, 3}), at::ones({3})), Error);
 }
 
 TEST(Denoiser, NullTokenReplacesTheContactCondition) {
