@@ -52,7 +52,8 @@ void DenoiserConfig::validate() const {
   require(feedforward >= 1, "feedforward", "must be positive");
   require(condition_hidden >= 1, "condition_hidden", "must be positive");
   require(dropout >= 0 && dropout < 1, "dropout", "must be in [0, 1)");
-  require(output == "x0" || output == "gaussian", "output", "must be x0 or gaussian, got '" + output + "'");
+  require(output == "x0" || output == "gaussian" || output == "temporal", "output",
+          "must be x0, gaussian or temporal, got '" + output + "'");
   require(skip_rank >= 1 && skip_rank <= 65536, "skip_rank", "must be in [1, 65536]");
 }
 
@@ -60,7 +61,7 @@ std::string DenoiserConfig::describe() const {
   return model + " denoiser: latent " + std::to_string(latent) + ", " + std::to_string(layers) +
          " layers, " + std::to_string(heads) + " heads, feed-forward " + std::to_string(feedforward) +
          ", condition MLPs " + std::to_string(condition_hidden) + ", window " + std::to_string(window) +
-         (output == "gaussian" ? ", Gaussian skip of rank " + std::to_string(std::min(skip_rank, sample_size)) : "");
+         (output != "x0" ? ", " + output + ", Gaussian skip of rank " + std::to_string(std::min(skip_rank, sample_size)) : "");
 }
 
 at::Tensor predict_x0(DenoiserImpl& net, const NoiseSchedule& schedule, const at::Tensor& x_t, const at::Tensor& t,
@@ -70,11 +71,38 @@ at::Tensor predict_x0(DenoiserImpl& net, const NoiseSchedule& schedule, const at
   const at::Tensor abar = at::tensor(schedule.alphas_cumprod, at::kDouble).index_select(0, t.to(at::kLong));
   const at::Tensor a = abar.to(x_t.scalar_type()).view({x_t.size(0), 1, 1});
   const at::Tensor& U = net.skip_directions();
+  if (net.config().output == "temporal") {
+    // Variances per (DCT frequency, direction); a window shorter than the model's uses the
+    // per-direction mean (no temporal filtering).
+    const int64_t T = x_t.size(1);
+    const bool full = T == net.config().window;
+    const at::Tensor v = full ? net.skip_variances().unsqueeze(0)                       // [1, T, k]
+                              : net.skip_variances().mean(0).view({1, 1, -1});
+    const at::Tensor den = a * v + (1.0 - a);
+    const at::Tensor g = a.sqrt() * v / den;
+    const double cells = full ? static_cast<double>(T) : 1.0;
+    const at::Tensor rest2 = (v * (1.0 - a) / den).sum({1, 2}, true).div(cells * x_t.size(-1)).sqrt();
+    at::Tensor z = at::matmul(x_t, U);  // [B, T, k]
+    if (full) {
+      const at::Tensor Q = dct_matrix(T);
+      z = at::matmul(Q.t(), at::matmul(Q, z) * g);
+    } else {
+      z = z * g;
+    }
+    return at::matmul(z, U.t()) + rest2 * out;
+  }
   const at::Tensor lam = net.skip_variances().view({1, 1, -1});
   const at::Tensor denom = a * lam + (1.0 - a);                                          // [B, 1, k]
   const at::Tensor gain = a.sqrt() * lam / denom;
   const at::Tensor rest = (lam * (1.0 - a) / denom).sum(-1, true).div(x_t.size(-1)).sqrt();  // [B, 1, 1]
   return at::matmul(at::matmul(x_t, U) * gain, U.t()) + rest * out;
+}
+
+at::Tensor dct_matrix(int64_t n) {
+  const at::Tensor k = at::arange(n, at::kDouble).unsqueeze(1), t = at::arange(n, at::kDouble).unsqueeze(0);
+  at::Tensor q = (M_PI / static_cast<double>(n) * (t + 0.5) * k).cos() * std::sqrt(2.0 / static_cast<double>(n));
+  q[0].mul_(std::sqrt(0.5));
+  return q.to(at::kFloat);
 }
 
 std::pair<at::Tensor, at::Tensor> principal_directions(const at::Tensor& samples, int k) {
@@ -134,10 +162,12 @@ DenoiserImpl::DenoiserImpl(const DenoiserConfig& config) : config_(config) {
   encoder_ = register_module(
       "encoder", torch::nn::TransformerEncoder(torch::nn::TransformerEncoderOptions(layer, config_.layers)));
   positions_ = register_buffer("positions", sinusoidal_positions(config_.window + 1, L));
-  if (config_.output == "gaussian") {
+  if (config_.output != "x0") {
     const int k = std::min(config_.skip_rank, config_.sample_size);
     skip_directions_ = register_buffer("skip_directions", torch::eye(config_.sample_size, k));
-    skip_variances_ = register_buffer("skip_variances", torch::ones({k}));
+    skip_variances_ = register_buffer("skip_variances", config_.output == "temporal"
+                                                           ? torch::ones({config_.window, k})
+                                                           : torch::ones({k}));
   }
 }
 

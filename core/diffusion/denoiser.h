@@ -39,8 +39,10 @@ struct DenoiserConfig {
   // S_t = U·diag(√ᾱ λ / (ᾱ λ + 1 − ᾱ))·Uᵀ, and c_t² = Σ λ(1 − ᾱ)/(ᾱ λ + 1 − ᾱ) / D its mean
   // remaining variance (Karras et al. 2022's c_skip/c_out with a covariance instead of one
   // σ_data). At low noise x0 is then x_t projected onto the data, at high noise the
-  // network's. Experimental: S_t filters each frame alone, so the noise it lets through is
-  // white over time and samples flicker (docs/training.md, "Output").
+  // network's. S_t filters each frame alone, so the noise it lets through is white over
+  // time and samples flicker. "temporal": the same filter in the basis DCT over the
+  // window's frames × U, with one variance per (frequency, direction) — smooth samples
+  // (docs/training.md, "Output"). Both experimental; the shipped models are "x0".
   std::string output = "x0";
   int skip_rank = 256;  // directions of S_t (at most sample_size)
 
@@ -69,8 +71,9 @@ class DenoiserImpl : public torch::nn::Module {
   at::Tensor forward(const at::Tensor& x_t, const at::Tensor& t, const at::Tensor& cond);
 
   const DenoiserConfig& config() const { return config_; }
-  // The Gaussian skip's directions U [sample, k] (orthonormal columns) and variances λ [k]
-  // (buffers, stored with the weights). Until set: the first k unit vectors, λ = 1.
+  // The skip's directions U [sample, k] (orthonormal columns) and variances λ: [k], or
+  // [window, k] per DCT frequency for "temporal" (buffers, stored with the weights). Until
+  // set: the first k unit vectors, λ = 1.
   void set_gaussian_skip(const at::Tensor& directions, const at::Tensor& variances);
   const at::Tensor& skip_directions() const { return skip_directions_; }
   const at::Tensor& skip_variances() const { return skip_variances_; }
@@ -94,6 +97,8 @@ at::Tensor predict_x0(DenoiserImpl& net, const NoiseSchedule& schedule, const at
 // The top k eigenvectors [D, k] and eigenvalues [k] (descending) of the second moment
 // XᵀX / N of samples X [N, D] (normalised data: mean ≈ 0), for set_gaussian_skip.
 std::pair<at::Tensor, at::Tensor> principal_directions(const at::Tensor& samples, int k);
+// The orthonormal DCT-II matrix [n, n] (row k = frequency k).
+at::Tensor dct_matrix(int64_t n);
 
 // Sinusoidal embedding [B, dim] of the steps t [B] (transformer style: sin then cos over
 // log-spaced frequencies from 1 to 1/10000).

@@ -327,11 +327,17 @@ static std::pair<at::Tensor, at::Tensor> fit_gaussian_skip(const TrainConfig& c,
     const WindowBatch b = data.batch(idx);
     const at::Tensor x = c.model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2)
                                               : stats.normalize_x(b.hand_features);
-    rows.push_back(x.reshape({-1, x.size(-1)}).index_select(0, at::nonzero(b.mask.reshape({-1}) > 0).squeeze(1)));
+    rows.push_back(x);
   }
-  auto fit = principal_directions(at::cat(rows, 0), c.network.skip_rank);
+  const at::Tensor all = at::cat(rows, 0);  // [n, W, D]; padding repeats the last frame
+  auto fit = principal_directions(all.reshape({-1, all.size(-1)}), c.network.skip_rank);
+  if (c.network.output == "temporal") {  // variance per (DCT frequency, direction)
+    const at::Tensor z = at::matmul(dct_matrix(all.size(1)), at::matmul(all, fit.first));  // [n, W, k]
+    fit.second = z.pow(2).mean(0).contiguous();
+  }
   log::info("Gaussian skip: {} directions hold {:.4f} of the samples' variance", fit.second.size(0),
-            fit.second.sum().item<double>() / static_cast<double>(c.network.sample_size));
+            fit.second.sum().item<double>() / static_cast<double>(c.network.sample_size) /
+                (c.network.output == "temporal" ? static_cast<double>(c.network.window) : 1.0));
   return fit;
 }
 
@@ -423,7 +429,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   Denoiser net(config.network);
   Denoiser ema_net(config.network);
   load_state(*ema_net, state_of(*net), "EMA copy");
-  if (config.network.output == "gaussian") {
+  if (config.network.output != "x0") {
     const auto [directions, variances] = fit_gaussian_skip(config, stats, train_set);
     net->set_gaussian_skip(directions, variances);
     ema_net->set_gaussian_skip(directions, variances);
