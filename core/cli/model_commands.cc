@@ -80,9 +80,8 @@ int run_check(const CheckArgs& a) {
   std::cout << fmt::format("{} model, {} windows of the {} split, {}\n", info.network.model, n, a.split,
                            motion ? (a.no_contact ? "null contact token" : "ground-truth contact maps")
                                   : "ground-truth object");
-  std::cout << fmt::format("one step (x0 from x_t): {} = error of {}; predicting the data mean: {:.2f} mm\n",
-                           motion ? "mm" : "mm", motion ? "the 200 surface keypoints H" : "the contact maps",
-                           mean_err);
+  std::cout << fmt::format("one step (x0 from x_t): mm = error of {}; predicting the data mean: {:.2f} mm\n",
+                           motion ? "the 200 surface keypoints H" : "the contact maps", mean_err);
   std::cout << "   t   abar     mse(norm)  error mm\n";
   at::Generator gen = at::detail::createCPUGenerator(static_cast<std::uint64_t>(a.seed));
   const auto& sched = model->schedule();
