@@ -7,7 +7,9 @@
 //    data mean — a model that has learnt something beats the mean at every t;
 //  - --sample: run the full sampler (as generation does) from noise with the ground-truth
 //    conditions and report the sample's error and frame-to-frame smoothness against the
-//    ground truth's — separates a weak denoiser from a sampling problem.
+//    ground truth's — separates a weak denoiser from a sampling problem; --from T starts
+//    from the truth noised to step T instead (SDEdit), which shows at which noise level
+//    samples leave the data.
 #include <fmt/format.h>
 
 #include <iostream>
@@ -18,16 +20,18 @@
 #include "core/cli/command.h"
 #include "core/data/normalization.h"
 #include "core/data/window_dataset.h"
-#include "core/diffusion/checkpoint.h"
+#include "core/diffusion/training.h"
 #include "core/diffusion/generation.h"
+#include "core/diffusion/sampler.h"
+#include "core/diffusion/schedule.h"
 #include "core/util/error.h"
 
 namespace bimart::cli {
 namespace {
 
 struct CheckArgs {
-  std::string checkpoint, dataset, split = "train", sampler = "ddpm";
-  int windows = 16, steps = 0;
+  std::string checkpoint, dataset, split = "train", sampler = "ddpm", expert;
+  int windows = 16, steps = 0, from = -1, expert_from = 40;
   long long seed = 1;
   double cfg = 0.5;
   bool sample = false, no_contact = false;
@@ -56,14 +60,12 @@ int run_check(const CheckArgs& a) {
   const WindowDataset data = WindowDataset::open(a.dataset, a.split, dopt);
   if (data.size() == 0) throw Error(a.dataset + ": no windows in the " + a.split + " split");
 
-  // Evenly spaced windows, fixed by the data set alone.
-  std::vector<std::int64_t> idx;
-  const int n = std::max(1, std::min<int>(a.windows, static_cast<int>(data.size())));
-  for (int i = 0; i < n; ++i) idx.push_back(static_cast<std::int64_t>(i) * static_cast<std::int64_t>(data.size()) / n);
+  const std::vector<std::int64_t> idx = data.spread(std::max(1, a.windows));  // fixed by the data set alone
+  const int n = static_cast<int>(idx.size());
   const WindowBatch b = data.batch(idx);
   const at::Tensor obj = st.normalize_object(b.object_features, b.global_states);
   const at::Tensor truth = motion ? b.hand_features : b.contact_maps.flatten(-2);  // metres
-  const at::Tensor x0 = motion ? st.normalize_x(truth) : st.normalize_c(b.contact_maps).flatten(-2);
+  const at::Tensor x0 = diffusion::normalized_sample(info.network.model, st, b);
   const auto to_metres = [&](const at::Tensor& z) {
     return motion ? st.denormalize_x(z) : st.denormalize_c(z.view({z.size(0), z.size(1), 2, 1024})).flatten(-2);
   };
@@ -72,7 +74,7 @@ int run_check(const CheckArgs& a) {
     return 1000.0 * (pred_m - truth).abs().mean().item<double>();
   };
 
-  diffusion::Denoiser net = diffusion::make_denoiser(diffusion::load_checkpoint(a.checkpoint), a.checkpoint);
+  diffusion::Denoiser net = model->network();
   const at::Tensor cond = motion && !a.no_contact
                               ? net->encode_conditions(obj, st.normalize_c(b.contact_maps).flatten(-2))
                               : net->encode_conditions(obj);
@@ -95,22 +97,52 @@ int run_check(const CheckArgs& a) {
     std::cout << fmt::format("  {:2d}  {:.4f}  {:9.4f}  {:8.2f}\n", t, sched.alphas_cumprod[t], mse,
                              metric(to_metres(pred)));
   }
-  if (!a.sample) return 0;
+  if (!a.sample && a.from < 0) return 0;
 
   diffusion::GenerateOptions g;
   g.sampler.sampler = a.sampler;
   g.sampler.steps = a.steps;
   g.cfg_lambda = a.cfg;
   g.use_contact = !a.no_contact;
-  std::vector<at::Tensor> outs;
-  for (int i = 0; i < n; ++i) {
-    const at::Tensor C = motion && !a.no_contact ? b.contact_maps[i] : at::Tensor();
-    outs.push_back(model->generate(b.object_features[i], b.global_states[i], C, nullptr, g, gen)[0]);
+  at::Tensor sm;  // [n, T, D] metres (contact maps flattened)
+  if (a.from < 0 && a.expert.empty()) {
+    std::vector<at::Tensor> outs;
+    for (int i = 0; i < n; ++i) {
+      const at::Tensor C = motion && !a.no_contact ? b.contact_maps[i] : at::Tensor();
+      outs.push_back(model->generate(b.object_features[i], b.global_states[i], C, nullptr, g, gen)[0]);
+    }
+    sm = motion ? at::stack(outs, 0) : at::stack(outs, 0).flatten(-2);
+  } else {  // all windows in one batch: from noise, or from the truth noised to step `from`
+    g.sampler.start = a.from;
+    const bool cfg = motion && !a.no_contact && a.cfg != 0.0;
+    const at::Tensor uncond = cfg ? net->encode_conditions(obj) : at::Tensor();
+    // An expert for the noisiest steps (t >= expert_from): another checkpoint of the same model.
+    diffusion::Denoiser expert{nullptr};
+    at::Tensor e_cond, e_uncond;
+    if (!a.expert.empty()) {
+      const auto e = diffusion::DiffusionModel::load(a.expert);
+      if (e->info().network.model != info.network.model || e->schedule().steps != sched.steps)
+        throw Error(a.expert + ": not a " + info.network.model + " model with the same schedule");
+      expert = e->network();
+      e_cond = motion && !a.no_contact ? expert->encode_conditions(obj, st.normalize_c(b.contact_maps).flatten(-2))
+                                       : expert->encode_conditions(obj);
+      if (cfg) e_uncond = expert->encode_conditions(obj);
+    }
+    const auto predict = [&](const at::Tensor& x, int t) {
+      const at::Tensor tt = at::full({x.size(0)}, t, at::kLong);
+      const bool high = !expert.is_empty() && t >= a.expert_from;
+      diffusion::DenoiserImpl& d = high ? *expert : *net;
+      const at::Tensor c = diffusion::predict_x0(d, sched, x, tt, high ? e_cond : cond);
+      return cfg ? diffusion::combine_cfg(c, diffusion::predict_x0(d, sched, x, tt, high ? e_uncond : uncond), a.cfg) : c;
+    };
+    const at::Tensor start =
+        a.from < 0 ? at::randn(x0.sizes(), gen)
+                   : diffusion::add_noise(sched, x0, at::randn(x0.sizes(), gen), at::full({x0.size(0)}, a.from, at::kLong));
+    sm = to_metres(diffusion::sample(sched, predict, start, g.sampler, gen));
   }
-  const at::Tensor s = at::stack(outs, 0);  // [n, T, D] metres
-  const at::Tensor sm = motion ? s : s.flatten(-2);
-  std::cout << fmt::format("sampled ({} {}{}): error {:.2f} mm\n", a.sampler, a.steps == 0 ? sched.steps : a.steps,
-                           motion ? fmt::format(", CFG {}", a.cfg) : "", metric(sm));
+  std::cout << fmt::format("sampled ({} {}{}{}): error {:.2f} mm\n", a.sampler, a.steps == 0 ? sched.steps : a.steps,
+                           motion ? fmt::format(", CFG {}", a.cfg) : "",
+                           a.from < 0 ? "" : fmt::format(", from the truth noised to t = {}", a.from), metric(sm));
   if (motion) {
     std::cout << fmt::format("  keypoint Accel (H): sample {:.3f} mm/frame², ground truth {:.3f}\n",
                              1000.0 * acceleration(sm.slice(2, 0, 600)), 1000.0 * acceleration(truth.slice(2, 0, 600)));
@@ -138,6 +170,11 @@ void add_model_commands(CLI::App& app, Commands& out) {
   check->add_option("--sampler", a->sampler, "ddpm or ddim (with --sample)")->capture_default_str();
   check->add_option("--steps", a->steps, "DDIM steps (0 = all)")->capture_default_str();
   check->add_option("--cfg", a->cfg, "Classifier-free guidance λ (motion model)")->capture_default_str();
+  check->add_option("--from", a->from, "Sample from the truth noised to this step instead of from noise (-1 = off)")
+      ->capture_default_str();
+  check->add_option("--expert", a->expert, "Experimental: another checkpoint of the same model for the noisiest steps")
+      ->check(CLI::ExistingFile);
+  check->add_option("--expert-from", a->expert_from, "The expert takes the steps t >= this")->capture_default_str();
   check->add_flag("--no-contact", a->no_contact, "Motion model: the null contact token instead of the maps");
   out.push_back({check, [a] { return run_check(*a); }, false});
 }

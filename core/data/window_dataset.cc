@@ -401,6 +401,14 @@ BpsVariant parse_bps_variant(const std::string& name) {
               ")");
 }
 
+std::vector<std::int64_t> WindowDataset::spread(std::int64_t count) const {
+  const auto size = static_cast<std::int64_t>(this->size());
+  const std::int64_t n = std::min(std::max<std::int64_t>(count, 0), size);
+  std::vector<std::int64_t> idx;
+  for (std::int64_t i = 0; i < n; ++i) idx.push_back(i * size / n);
+  return idx;
+}
+
 std::vector<std::int32_t> window_starts(std::int64_t frames, int window, int stride) {
   if (window < 1 || stride < 1) throw Error("windows need window >= 1 and stride >= 1");
   std::vector<std::int32_t> out;

@@ -133,6 +133,9 @@ class WindowDataset {
   // draw uses only rng's raw output (no std distributions), so a seed gives the same batch
   // on every platform.
   WindowBatch sample_batch(std::int64_t batch_size, std::mt19937_64& rng) const;
+  // min(count, size()) window indices spread evenly (i · size() / count): a fixed subset,
+  // the same for every run, for validation and checks.
+  std::vector<std::int64_t> spread(std::int64_t count) const;
   // All window indices in a random order (Fisher-Yates with rng's raw output): an epoch.
   std::vector<std::int64_t> shuffled(std::mt19937_64& rng) const;
 

@@ -71,31 +71,25 @@ at::Tensor predict_x0(DenoiserImpl& net, const NoiseSchedule& schedule, const at
   const at::Tensor abar = at::tensor(schedule.alphas_cumprod, at::kDouble).index_select(0, t.to(at::kLong));
   const at::Tensor a = abar.to(x_t.scalar_type()).view({x_t.size(0), 1, 1});
   const at::Tensor& U = net.skip_directions();
-  if (net.config().output == "temporal") {
-    // Variances per (DCT frequency, direction); a window shorter than the model's uses the
-    // per-direction mean (no temporal filtering).
-    const int64_t T = x_t.size(1);
-    const bool full = T == net.config().window;
-    const at::Tensor v = full ? net.skip_variances().unsqueeze(0)                       // [1, T, k]
-                              : net.skip_variances().mean(0).view({1, 1, -1});
-    const at::Tensor den = a * v + (1.0 - a);
-    const at::Tensor g = a.sqrt() * v / den;
-    const double cells = full ? static_cast<double>(T) : 1.0;
-    const at::Tensor rest2 = (v * (1.0 - a) / den).sum({1, 2}, true).div(cells * x_t.size(-1)).sqrt();
-    at::Tensor z = at::matmul(x_t, U);  // [B, T, k]
-    if (full) {
-      const at::Tensor Q = dct_matrix(T);
-      z = at::matmul(Q.t(), at::matmul(Q, z) * g);
-    } else {
-      z = z * g;
-    }
-    return at::matmul(z, U.t()) + rest2 * out;
+  // Variances per direction ([k], `gaussian`) or per (DCT frequency, direction) ([T, k],
+  // `temporal`); a window shorter than the model's uses the per-direction mean (no
+  // temporal filtering).
+  const int64_t T = x_t.size(1);
+  const bool temporal = net.config().output == "temporal" && T == net.config().window;
+  at::Tensor v = net.skip_variances();
+  v = temporal ? v.unsqueeze(0) : (v.dim() == 2 ? v.mean(0) : v).view({1, 1, -1});  // [1, T or 1, k]
+  const at::Tensor den = a * v + (1.0 - a);
+  const at::Tensor gain = a.sqrt() * v / den;
+  // c_t: the root of the variance the filter leaves, per sample entry.
+  const at::Tensor rest = (v * (1.0 - a) / den).sum({1, 2}, true).div(static_cast<double>(v.size(1) * x_t.size(-1))).sqrt();
+  at::Tensor z = at::matmul(x_t, U);  // [B, T, k]
+  if (temporal) {
+    const at::Tensor Q = dct_matrix(T);
+    z = at::matmul(Q.t(), at::matmul(Q, z) * gain);
+  } else {
+    z = z * gain;
   }
-  const at::Tensor lam = net.skip_variances().view({1, 1, -1});
-  const at::Tensor denom = a * lam + (1.0 - a);                                          // [B, 1, k]
-  const at::Tensor gain = a.sqrt() * lam / denom;
-  const at::Tensor rest = (lam * (1.0 - a) / denom).sum(-1, true).div(x_t.size(-1)).sqrt();  // [B, 1, 1]
-  return at::matmul(at::matmul(x_t, U) * gain, U.t()) + rest * out;
+  return at::matmul(z, U.t()) + rest * out;
 }
 
 at::Tensor dct_matrix(int64_t n) {

@@ -40,6 +40,8 @@ class DiffusionModel {
   const std::string& path() const { return path_; }
   const NoiseSchedule& schedule() const { return schedule_; }
   int window() const { return checkpoint_.info.network.window; }
+  // The denoiser (EMA weights), shared: for checks that call it step by step.
+  Denoiser network() const { return net_; }
 
   // Generates S = options.samples samples for N frames.
   // object_features O [N, 1024, 3], global_states G [N, 7] (translation relative to any

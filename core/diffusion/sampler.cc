@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/util/error.h"
@@ -10,9 +11,13 @@ namespace bimart::diffusion {
 
 std::vector<int> sampling_timesteps(const NoiseSchedule& s, const SamplerOptions& o) {
   const int T = s.steps;
+  if (o.start < -1 || o.start >= T)
+    throw Error("the first sampling step must be in [0, " + std::to_string(T - 1) + "] (or -1 = the last), got " +
+                std::to_string(o.start));
+  const int first = o.start < 0 ? T - 1 : o.start;
   std::vector<int> ts;
   if (o.sampler == "ddpm") {
-    for (int t = T - 1; t >= 0; --t) ts.push_back(t);
+    for (int t = first; t >= 0; --t) ts.push_back(t);
     return ts;
   }
   if (o.sampler != "ddim") throw Error("unknown sampler '" + o.sampler + "' (known: ddpm, ddim)");
@@ -20,9 +25,9 @@ std::vector<int> sampling_timesteps(const NoiseSchedule& s, const SamplerOptions
     throw Error("DDIM steps must be in [0, " + std::to_string(T) + "] (0 = all), got " +
                 std::to_string(o.steps));
   }
-  const int k = o.steps == 0 ? T : o.steps;
+  const int k = std::min(o.steps == 0 ? T : o.steps, first + 1);
   for (int i = 0; i < k; ++i) {
-    const double pos = k == 1 ? T - 1 : (T - 1) * (1.0 - static_cast<double>(i) / (k - 1));
+    const double pos = k == 1 ? first : first * (1.0 - static_cast<double>(i) / (k - 1));
     ts.push_back(static_cast<int>(std::lround(pos)));
   }
   return ts;

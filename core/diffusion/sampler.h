@@ -25,11 +25,13 @@ struct SamplerOptions {
   std::string sampler = "ddpm";  // "ddpm" or "ddim"
   int steps = 0;                 // DDIM steps (0 = all T); DDPM always takes all T
   double eta = 0.0;              // DDIM noise: 0 = deterministic, 1 = DDPM-like
+  int start = -1;                // the noisiest step visited (-1 = T-1); lower starts from a
+                                 // partly noised sample (SDEdit), e.g. for `bimart model check --from`
 };
 
-// The schedule steps visited, noisiest first: T-1, ..., 0 for DDPM; for DDIM `steps`
-// values spread evenly over [0, T-1], both ends included. Throws for a bad sampler name or
-// steps outside [0, T].
+// The schedule steps visited, noisiest first: S, ..., 0 for DDPM; for DDIM `steps` values
+// spread evenly over [0, S], both ends included (S = start, or T-1). Throws for a bad
+// sampler name, steps outside [0, T] or start outside [-1, T-1].
 std::vector<int> sampling_timesteps(const NoiseSchedule& s, const SamplerOptions& o);
 
 // Runs the reverse process from x_T (noise, [B, ...]) and returns the clean sample: the

@@ -285,15 +285,17 @@ double learning_rate(const TrainConfig& c, std::int64_t step) {
 
 // ---- one step ----
 
+at::Tensor normalized_sample(const std::string& model, const NormalizationStats& stats, const WindowBatch& b) {
+  return model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2) : stats.normalize_x(b.hand_features);
+}
+
 StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b,
                             at::Generator gen) {
   StepInputs in;
   const auto B = b.hand_features.size(0);
   in.object = stats.normalize_object(b.object_features, b.global_states);
-  if (c.model == "contact") {
-    in.sample = stats.normalize_c(b.contact_maps).flatten(-2);
-  } else {
-    in.sample = stats.normalize_x(b.hand_features);
+  in.sample = normalized_sample(c.model, stats, b);
+  if (c.model == "motion") {
     in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
     in.use_contact = at::rand({B}, gen) >= c.contact_dropout;
   }
@@ -318,16 +320,11 @@ LossParts step_loss(Denoiser& net, const NoiseSchedule& schedule, const StepInpu
 // to 1024 windows spread evenly over the train split (deterministic).
 static std::pair<at::Tensor, at::Tensor> fit_gaussian_skip(const TrainConfig& c, const NormalizationStats& stats,
                                                     const WindowDataset& data) {
-  const std::int64_t n = std::min<std::int64_t>(1024, static_cast<std::int64_t>(data.size()));
+  const std::vector<std::int64_t> idx = data.spread(1024);
   std::vector<at::Tensor> rows;
-  for (std::int64_t first = 0; first < n; first += 128) {
-    std::vector<std::int64_t> idx;
-    for (std::int64_t i = first; i < std::min(n, first + 128); ++i)
-      idx.push_back(i * static_cast<std::int64_t>(data.size()) / n);
-    const WindowBatch b = data.batch(idx);
-    const at::Tensor x = c.model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2)
-                                              : stats.normalize_x(b.hand_features);
-    rows.push_back(x);
+  for (std::size_t first = 0; first < idx.size(); first += 128) {
+    const auto last = idx.begin() + static_cast<std::ptrdiff_t>(std::min(idx.size(), first + 128));
+    rows.push_back(normalized_sample(c.model, stats, data.batch({idx.begin() + static_cast<std::ptrdiff_t>(first), last})));
   }
   const at::Tensor all = at::cat(rows, 0);  // [n, W, D]; padding repeats the last frame
   auto fit = principal_directions(all.reshape({-1, all.size(-1)}), c.network.skip_rank);
@@ -335,9 +332,10 @@ static std::pair<at::Tensor, at::Tensor> fit_gaussian_skip(const TrainConfig& c,
     const at::Tensor z = at::matmul(dct_matrix(all.size(1)), at::matmul(all, fit.first));  // [n, W, k]
     fit.second = z.pow(2).mean(0).contiguous();
   }
-  log::info("Gaussian skip: {} directions hold {:.4f} of the samples' variance", fit.second.size(0),
-            fit.second.sum().item<double>() / static_cast<double>(c.network.sample_size) /
-                (c.network.output == "temporal" ? static_cast<double>(c.network.window) : 1.0));
+  // The DCT is orthonormal, so the temporal variances sum to the directions' variances × W.
+  log::info("Gaussian skip ({}): the top {} directions hold {:.4f} of the normalised samples' variance", c.network.output,
+            fit.first.size(1), fit.second.sum().item<double>() / static_cast<double>(c.network.sample_size) /
+                (c.network.output == "temporal" ? static_cast<double>(all.size(1)) : 1.0));
   return fit;
 }
 
@@ -495,19 +493,16 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
 
   const auto validation_loss = [&]() {
     torch::NoGradGuard ng;
-    const std::int64_t n = std::min<std::int64_t>(config.validation_windows, static_cast<std::int64_t>(test_set->size()));
+    const std::vector<std::int64_t> idx = test_set->spread(config.validation_windows);
     double sum = 0, frames = 0;
-    constexpr std::int64_t kChunk = 32;
-    for (std::int64_t first = 0, chunk = 0; first < n; first += kChunk, ++chunk) {
-      std::vector<std::int64_t> idx;
-      for (std::int64_t i = first; i < std::min(n, first + kChunk); ++i)
-        idx.push_back(i * static_cast<std::int64_t>(test_set->size()) / n);
-      const WindowBatch b = test_set->batch(idx);
+    constexpr std::size_t kChunk = 32;
+    for (std::size_t first = 0, chunk = 0; first < idx.size(); first += kChunk, ++chunk) {
+      const WindowBatch b = test_set->batch({idx.begin() + static_cast<std::ptrdiff_t>(first),
+                                             idx.begin() + static_cast<std::ptrdiff_t>(std::min(idx.size(), first + kChunk))});
       auto gen = at::detail::createCPUGenerator(static_cast<std::uint64_t>(1000003 + chunk));
       StepInputs in;
       in.object = stats.normalize_object(b.object_features, b.global_states);
-      in.sample = config.model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2)
-                                            : stats.normalize_x(b.hand_features);
+      in.sample = normalized_sample(config.model, stats, b);
       if (config.model == "motion") in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
       in.mask = b.mask;
       in.noise = at::randn(in.sample.sizes(), gen);

@@ -97,6 +97,9 @@ struct StepInputs {
   at::Tensor noise;      // [B, T, S]
   at::Tensor t;          // [B] int64
 };
+// What a model denoises, normalised: the contact maps C [B, T, 2048] ("contact") or the
+// hand features X [B, T, 1200] ("motion") of a batch.
+at::Tensor normalized_sample(const std::string& model, const NormalizationStats& stats, const WindowBatch& batch);
 // Builds StepInputs from a batch: normalisation, and noise, steps and contact dropout
 // drawn from `gen`.
 StepInputs make_step_inputs(const TrainConfig& config, const NormalizationStats& stats,

@@ -11,6 +11,9 @@
 #include "core/diffusion/checkpoint.h"
 #include "core/io/npz.h"
 #include "core/util/error.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart::diffusion {
 namespace {
@@ -56,15 +59,6 @@ std::string scratch(const std::string& name) {
   return (dir / name).string();
 }
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(Checkpoint, RoundTripKeepsWeightsAndInfo) {
   const Checkpoint c = tiny_checkpoint();
   const std::string path = scratch("round.npz");
@@ -102,23 +96,23 @@ TEST(Checkpoint, OutputKindRoundTripsAndOlderFilesPredictX0) {
 TEST(Checkpoint, MismatchesNameWhatDiffers) {
   const Checkpoint c = tiny_checkpoint();
   EXPECT_NO_THROW(check_compatible(c.info, "m.npz", "contact", "np_bps", c.info.basis_points, c.info.keypoints));
-  const std::string kind = message_of([&] { check_compatible(c.info, "m.npz", "motion", "", {}, {}); });
+  const std::string kind = error_of([&] { check_compatible(c.info, "m.npz", "motion", "", {}, {}); });
   EXPECT_NE(kind.find("not a motion model"), std::string::npos) << kind;
-  const std::string variant = message_of([&] { check_compatible(c.info, "m.npz", "", "u_bps", {}, {}); });
+  const std::string variant = error_of([&] { check_compatible(c.info, "m.npz", "", "u_bps", {}, {}); });
   EXPECT_NE(variant.find("encoder variant"), std::string::npos) << variant;
   const std::string basis =
-      message_of([&] { check_compatible(c.info, "m.npz", "", "", c.info.basis_points + 0.01, {}); });
+      error_of([&] { check_compatible(c.info, "m.npz", "", "", c.info.basis_points + 0.01, {}); });
   EXPECT_NE(basis.find("basis points"), std::string::npos) << basis;
   auto other = c.info.keypoints;
   other[5] += 1;
-  const std::string keys = message_of([&] { check_compatible(c.info, "m.npz", "", "", {}, other); });
+  const std::string keys = error_of([&] { check_compatible(c.info, "m.npz", "", "", {}, other); });
   EXPECT_NE(keys.find("hand keypoints"), std::string::npos) << keys;
   EXPECT_NE(keys.find("index 5"), std::string::npos) << keys;
   // Weights of another network.
   DenoiserConfig bigger = c.info.network;
   bigger.latent = 32;
   Denoiser net(bigger);
-  const std::string shape = message_of([&] { load_state(*net, c.weights, "m.npz"); });
+  const std::string shape = error_of([&] { load_state(*net, c.weights, "m.npz"); });
   EXPECT_NE(shape.find("m.npz"), std::string::npos) << shape;
   EXPECT_NE(shape.find("shape"), std::string::npos) << shape;
 }
@@ -131,14 +125,14 @@ TEST(Checkpoint, TruncatedAndForeignFilesAreClearErrors) {
     const std::string cut = scratch("cut.npz");
     fs::copy_file(path, cut, fs::copy_options::overwrite_existing);
     fs::resize_file(cut, static_cast<std::uintmax_t>(keep * size));
-    const std::string msg = message_of([&] { load_checkpoint(cut); });
+    const std::string msg = error_of([&] { load_checkpoint(cut); });
     EXPECT_NE(msg.find(cut), std::string::npos) << keep << ": " << msg;
   }
   NpzFile foreign;
   foreign.set("x", make_npy_scalar<double>(1.0));
   const std::string other = scratch("foreign.npz");
   foreign.write(other);
-  const std::string msg = message_of([&] { load_checkpoint(other); });
+  const std::string msg = error_of([&] { load_checkpoint(other); });
   EXPECT_NE(msg.find("not a bimart model checkpoint"), std::string::npos) << msg;
 }
 

@@ -85,6 +85,21 @@ TEST(Sampler, TimestepsOfDdpmAndDdim) {
   EXPECT_THROW(sampling_timesteps(s, {"euler", 0, 0}), Error);
 }
 
+TEST(Sampler, ALaterStartVisitsOnlyTheStepsBelowIt) {
+  const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
+  const auto ddpm = sampling_timesteps(s, {"ddpm", 0, 0, 20});
+  ASSERT_EQ(ddpm.size(), 21u);
+  EXPECT_EQ(ddpm.front(), 20);
+  EXPECT_EQ(ddpm.back(), 0);
+  const auto ddim = sampling_timesteps(s, {"ddim", 5, 0, 20});
+  EXPECT_EQ(ddim, (std::vector<int>{20, 15, 10, 5, 0}));
+  // More DDIM steps than there are below the start: each step once.
+  EXPECT_EQ(sampling_timesteps(s, {"ddim", 10, 0, 3}), (std::vector<int>{3, 2, 1, 0}));
+  EXPECT_EQ(sampling_timesteps(s, {"ddpm", 0, 0, -1}).front(), 49);
+  EXPECT_THROW(sampling_timesteps(s, {"ddpm", 0, 0, 50}), Error);
+  EXPECT_THROW(sampling_timesteps(s, {"ddpm", 0, 0, -2}), Error);
+}
+
 class PerfectPredictor : public ::testing::TestWithParam<SamplerOptions> {};
 
 TEST_P(PerfectPredictor, ReturnsTheData) {
@@ -104,7 +119,8 @@ TEST_P(PerfectPredictor, ReturnsTheData) {
 
 INSTANTIATE_TEST_SUITE_P(Samplers, PerfectPredictor,
                          ::testing::Values(SamplerOptions{"ddpm", 0, 0}, SamplerOptions{"ddim", 10, 0},
-                                           SamplerOptions{"ddim", 10, 1.0}));
+                                           SamplerOptions{"ddim", 10, 1.0}, SamplerOptions{"ddpm", 0, 0, 12},
+                                           SamplerOptions{"ddim", 4, 0, 30}));
 
 TEST(Sampler, DdpmStepsTowardTheDataWithAPerfectPredictor) {
   // The iterates approach the data: the distance after the second-last step is far below

@@ -8,21 +8,15 @@
 
 #include "core/io/npz.h"
 #include "tests/hand/synthetic_model.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart {
 namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "<no bimart::Error>";
-}
 
 class HandModelTest : public ::testing::Test {
  protected:

@@ -1,4 +1,7 @@
 #include "core/io/npz.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -38,15 +41,6 @@ void write_bytes(const std::string& p, const std::vector<uint8_t>& b) {
   std::ofstream out(p, std::ios::binary);
   out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
 }
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "<no bimart::Error>";
-}
-
 // One array of every supported dtype, and the shapes that are easy to get wrong.
 NpzFile every_dtype() {
   NpzFile npz;

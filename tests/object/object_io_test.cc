@@ -13,6 +13,9 @@
 #include "core/object/mesh_repair.h"
 #include "core/object/object_state.h"
 #include "core/util/error.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart {
 namespace {
@@ -37,17 +40,6 @@ class ObjectIo : public ::testing::Test {
   }
   fs::path dir_;
 };
-
-// The message of the bimart::Error `f` throws, or "" when it throws none.
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST_F(ObjectIo, SaveLoadRoundTrip) {
   const ArticulatedObject o = make_object("laptop", 3);

@@ -15,21 +15,14 @@
 #include "core/object/object_distance.h"
 #include "core/object/object_state.h"
 #include "core/util/error.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart {
 namespace {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(GeometryGuard, MeshDistanceRefusesNaNAndFarPoints) {
   const ArticulatedObject o = make_object("box", 1);

@@ -12,21 +12,14 @@
 #include "core/util/error.h"
 #include "core/util/yaml_keys.h"
 #include "tests/robust/fixture.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart {
 namespace {
 
 using test::ScratchDir;
-
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(NpzCrc, FlippedBytesInAStoredMemberAreRefused) {
   ScratchDir dir("crc");

@@ -19,21 +19,14 @@
 #include "core/object/object_io.h"
 #include "core/object/object_state.h"
 #include "core/util/error.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart {
 namespace {
 
 namespace fs = std::filesystem;
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // A closed box with a lid in the canonical frame of the families: hinge on -z through the
 // origin, extending towards -x, base below y = 0, lid above, centred along z.

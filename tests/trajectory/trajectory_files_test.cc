@@ -16,6 +16,9 @@
 #include "core/trajectory/trajectory.h"
 #include "core/trajectory/trajectory_object.h"
 #include "core/trajectory/validation.h"
+#include "tests/error_of.h"
+
+using bimart::test::error_of;
 
 namespace bimart {
 namespace {
@@ -38,16 +41,6 @@ class TrajectoryFiles : public ::testing::Test {
   }
   fs::path dir_;
 };
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 StateRows random_states(Eigen::Index n, unsigned seed) {
   std::mt19937_64 rng(seed);
