@@ -144,6 +144,14 @@ int run_check(const CheckArgs& a) {
                            motion ? fmt::format(", CFG {}", a.cfg) : "",
                            a.from < 0 ? "" : fmt::format(", from the truth noised to t = {}", a.from), metric(sm));
   if (motion) {
+    // Placement vs shape: the error of each hand's keypoint centroid, and what is left
+    // once both centroids are matched.
+    const auto hands = [](const at::Tensor& x) { return x.slice(2, 0, 600).reshape({x.size(0), x.size(1), 2, 100, 3}); };
+    const at::Tensor hs = hands(sm), ht = hands(truth);
+    const at::Tensor cs = hs.mean(3, true), ct = ht.mean(3, true);
+    std::cout << fmt::format("  hand centroid error {:.2f} mm; keypoints with the centroids matched {:.2f} mm\n",
+                             1000.0 * (cs - ct).norm(2, -1).mean().item<double>(),
+                             1000.0 * ((hs - cs) - (ht - ct)).norm(2, -1).mean().item<double>());
     std::cout << fmt::format("  keypoint Accel (H): sample {:.3f} mm/frame², ground truth {:.3f}\n",
                              1000.0 * acceleration(sm.slice(2, 0, 600)), 1000.0 * acceleration(truth.slice(2, 0, 600)));
   } else {

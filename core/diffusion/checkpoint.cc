@@ -74,6 +74,7 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   f.set("network/dropout", make_npy_scalar<double>(i.network.dropout));
   set_string(f, "network/output", i.network.output);
   f.set("network/skip_rank", make_npy_scalar<std::int64_t>(i.network.skip_rank));
+  f.set("network/contact_cue", make_npy_scalar<std::int64_t>(i.network.contact_cue ? 1 : 0));
   set_string(f, "diffusion/schedule", i.schedule);
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
   set_string(f, "encoder/variant", i.variant);
@@ -121,6 +122,8 @@ Checkpoint load_checkpoint(const std::string& path) {
     if (k < 1 || k > 65536) throw Error(f.where("network/skip_rank") + ": out of range");
     i.network.skip_rank = static_cast<int>(k);
   }
+  // Checkpoints from before the contact cue have none.
+  i.network.contact_cue = f.contains("network/contact_cue") && get_int(f, "network/contact_cue") != 0;
   try {
     i.network.validate();
   } catch (const Error& e) {

@@ -3,10 +3,16 @@
 #include <torch/nn/modules/activation.h>
 #include <torch/nn/modules/transformerlayer.h>
 
+#include <ATen/core/grad_mode.h>
+#include <ATen/ops/_transformer_encoder_layer_fwd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "core/diffusion/schedule.h"
+#include "core/features/contact_cue.h"
 #include "core/util/error.h"
 
 namespace bimart::diffusion {
@@ -55,12 +61,15 @@ void DenoiserConfig::validate() const {
   require(output == "x0" || output == "gaussian" || output == "temporal", "output",
           "must be x0, gaussian or temporal, got '" + output + "'");
   require(skip_rank >= 1 && skip_rank <= 65536, "skip_rank", "must be in [1, 65536]");
+  require(!contact_cue || (model == "motion" && contact_condition_size == 2 * 1024 && object_condition_size == 3079),
+          "contact_cue", "needs the motion model with contact maps [2, 1024] and object features [1024, 3 | 7]");
 }
 
 std::string DenoiserConfig::describe() const {
   return model + " denoiser: latent " + std::to_string(latent) + ", " + std::to_string(layers) +
          " layers, " + std::to_string(heads) + " heads, feed-forward " + std::to_string(feedforward) +
          ", condition MLPs " + std::to_string(condition_hidden) + ", window " + std::to_string(window) +
+         (contact_cue ? ", contact cue" : "") +
          (output != "x0" ? ", " + output + ", Gaussian skip of rank " + std::to_string(std::min(skip_rank, sample_size)) : "");
 }
 
@@ -121,6 +130,31 @@ void DenoiserImpl::set_gaussian_skip(const at::Tensor& directions, const at::Ten
   skip_variances_.copy_(variances);
 }
 
+void DenoiserImpl::set_cue_frame(const at::Tensor& object_mean, const at::Tensor& object_std,
+                                 const at::Tensor& contact_mean, const at::Tensor& contact_std,
+                                 const at::Tensor& basis_points, bool scaled) {
+  if (!config_.contact_cue) throw Error("denoiser: set_cue_frame on a model without the contact cue");
+  const std::vector<std::pair<const at::Tensor*, at::Tensor*>> pairs = {
+      {&object_mean, &cue_object_mean_}, {&object_std, &cue_object_std_}, {&contact_mean, &cue_contact_mean_},
+      {&contact_std, &cue_contact_std_}, {&basis_points, &cue_basis_}};
+  for (const auto& [from, to] : pairs)
+    if (!from->sizes().equals(to->sizes()))
+      throw Error("denoiser: contact cue frame must be " + c10::str(to->sizes()) + ", got " + c10::str(from->sizes()));
+  torch::NoGradGuard ng;
+  for (const auto& [from, to] : pairs) to->copy_(*from);
+  cue_scaled_.fill_(scaled ? 1.0 : 0.0);
+}
+
+at::Tensor DenoiserImpl::contact_cue_of(const at::Tensor& object, const at::Tensor& contact) const {
+  const auto B = object.size(0), T = object.size(1);
+  const at::Tensor obj = object * cue_object_std_ + cue_object_mean_;  // [B, T, 3079]
+  const at::Tensor O = obj.slice(2, 0, 3072).reshape({B, T, 1024, 3});
+  const at::Tensor s_o = obj.select(2, 3078);                          // G's last entry
+  const at::Tensor scale = cue_scaled_.item<float>() > 0.5f ? s_o : at::ones_like(s_o);
+  const at::Tensor C = (contact * cue_contact_std_ + cue_contact_mean_).view({B, T, 2, 1024});
+  return contact_cue(object_points_from_bps(O, cue_basis_, scale), C);
+}
+
 at::Tensor timestep_embedding(const at::Tensor& t, int dim) {
   const int half = dim / 2;
   const auto freqs =
@@ -145,7 +179,8 @@ DenoiserImpl::DenoiserImpl(const DenoiserConfig& config) : config_(config) {
   object_mlp_ = register_module("object_mlp", condition_mlp(config_.object_condition_size,
                                                             config_.condition_hidden, L));
   if (config_.contact_condition_size > 0) {
-    contact_mlp_ = register_module("contact_mlp", condition_mlp(config_.contact_condition_size,
+    const int cue = config_.contact_cue ? kContactCueSize : 0;
+    contact_mlp_ = register_module("contact_mlp", condition_mlp(config_.contact_condition_size + cue,
                                                                 config_.condition_hidden, L));
     null_contact_ = register_parameter("null_contact", torch::randn({config_.window, L}) * 0.02);
   }
@@ -156,6 +191,14 @@ DenoiserImpl::DenoiserImpl(const DenoiserConfig& config) : config_(config) {
   encoder_ = register_module(
       "encoder", torch::nn::TransformerEncoder(torch::nn::TransformerEncoderOptions(layer, config_.layers)));
   positions_ = register_buffer("positions", sinusoidal_positions(config_.window + 1, L));
+  if (config_.contact_cue) {
+    cue_object_mean_ = register_buffer("cue_object_mean", torch::zeros({config_.object_condition_size}));
+    cue_object_std_ = register_buffer("cue_object_std", torch::ones({config_.object_condition_size}));
+    cue_contact_mean_ = register_buffer("cue_contact_mean", torch::zeros({config_.contact_condition_size}));
+    cue_contact_std_ = register_buffer("cue_contact_std", torch::ones({config_.contact_condition_size}));
+    cue_basis_ = register_buffer("cue_basis", torch::zeros({1024, 3}));
+    cue_scaled_ = register_buffer("cue_scaled", torch::ones({1}));
+  }
   if (config_.output != "x0") {
     const int k = std::min(config_.skip_rank, config_.sample_size);
     skip_directions_ = register_buffer("skip_directions", torch::eye(config_.sample_size, k));
@@ -185,7 +228,8 @@ at::Tensor DenoiserImpl::encode_conditions(const at::Tensor& object, const at::T
     throw Error("denoiser: contact condition must be [" + std::to_string(B) + ", " + std::to_string(T) +
                 ", " + std::to_string(config_.contact_condition_size) + "], got " + c10::str(contact.sizes()));
   }
-  const at::Tensor c = contact_mlp_->forward(contact);
+  const at::Tensor c = contact_mlp_->forward(
+      config_.contact_cue ? torch::cat({contact, contact_cue_of(object, contact)}, -1) : contact);
   if (!use_contact.defined()) return cond + c;
   const at::Tensor keep = use_contact.to(torch::kBool).view({B, 1, 1});
   return cond + torch::where(keep, c, null);
@@ -204,9 +248,28 @@ at::Tensor DenoiserImpl::forward(const at::Tensor& x_t, const at::Tensor& t, con
   const at::Tensor frames = input_->forward(x_t) + cond;                         // [B, T, L]
   const at::Tensor step = time_mlp_->forward(timestep_embedding(t, config_.latent)).unsqueeze(1);
   const at::Tensor tokens = torch::cat({step, frames}, 1) + positions_.slice(0, 0, T + 1).unsqueeze(0);
-  // libtorch's encoder takes [sequence, batch, latent].
-  const at::Tensor encoded = encoder_->forward(tokens.transpose(0, 1)).transpose(0, 1);
+  // Sampling (no autograd, eval mode) runs each layer as ATen's fused encoder-layer kernel
+  // (the one PyTorch's Python fast path calls): ~10 ops per layer where the module runs ~60,
+  // and at this size the time goes to op overhead. Training uses the module.
+  const bool fused = !is_training() && !at::GradMode::is_enabled();
+  // libtorch's encoder module takes [sequence, batch, latent]; the fused kernel batch first.
+  const at::Tensor encoded = fused ? encode_fused(tokens) : encoder_->forward(tokens.transpose(0, 1)).transpose(0, 1);
   return output_->forward(encoded.slice(1, 1, T + 1));
+}
+
+at::Tensor DenoiserImpl::encode_fused(const at::Tensor& tokens) const {
+  at::Tensor x = tokens;
+  for (const auto& module : *encoder_->layers) {
+    const auto& layer = module->as<torch::nn::TransformerEncoderLayerImpl>();
+    const auto& attention = *layer->self_attn;
+    x = at::_transformer_encoder_layer_fwd(
+        x, config_.latent, config_.heads, attention.in_proj_weight, attention.in_proj_bias,
+        attention.out_proj->weight, attention.out_proj->bias, /*use_gelu=*/true, /*norm_first=*/false,
+        layer->norm1->options.eps(), layer->norm1->weight, layer->norm1->bias, layer->norm2->weight,
+        layer->norm2->bias, layer->linear1->weight, layer->linear1->bias, layer->linear2->weight,
+        layer->linear2->bias);
+  }
+  return x;
 }
 
 std::int64_t DenoiserImpl::num_parameters() const {

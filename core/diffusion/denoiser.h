@@ -45,6 +45,10 @@ struct DenoiserConfig {
   // (docs/training.md, "Output"). Both experimental; the shipped models are "x0".
   std::string output = "x0";
   int skip_rank = 256;  // directions of S_t (at most sample_size)
+  // Motion model: the contact MLP also reads the contact cue of C (core/features/contact_cue.h),
+  // computed inside encode_conditions from the normalised inputs with the frame set by
+  // set_cue_frame (stored with the weights).
+  bool contact_cue = false;
 
   // The configuration of a model kind with the paper's size (DESIGN §5).
   static DenoiserConfig paper(const std::string& model);
@@ -75,6 +79,11 @@ class DenoiserImpl : public torch::nn::Module {
   // [window, k] per DCT frequency for "temporal" (buffers, stored with the weights). Until
   // set: the first k unit vectors, λ = 1.
   void set_gaussian_skip(const at::Tensor& directions, const at::Tensor& variances);
+  // What the contact cue needs to undo the normalisation of its inputs: the object
+  // condition's and the contact maps' mean and std ([3079], [2048]), the basis points
+  // [1024, 3], and whether encoder space is scaled by s_o (false for U-BPS).
+  void set_cue_frame(const at::Tensor& object_mean, const at::Tensor& object_std, const at::Tensor& contact_mean,
+                     const at::Tensor& contact_std, const at::Tensor& basis_points, bool scaled);
   const at::Tensor& skip_directions() const { return skip_directions_; }
   const at::Tensor& skip_variances() const { return skip_variances_; }
   std::int64_t num_parameters() const;
@@ -87,6 +96,11 @@ class DenoiserImpl : public torch::nn::Module {
   at::Tensor null_contact_;  // [window, latent] parameter (motion model)
   at::Tensor positions_;     // [window + 1, latent] buffer: sinusoidal positions
   at::Tensor skip_directions_, skip_variances_;  // "gaussian" output: [sample, k], [k] buffers
+  // contact_cue: buffers object mean/std [3079], contact mean/std [2048], basis [1024, 3],
+  // scaled [1] (1 = divide by s_o).
+  at::Tensor cue_object_mean_, cue_object_std_, cue_contact_mean_, cue_contact_std_, cue_basis_, cue_scaled_;
+  at::Tensor encode_fused(const at::Tensor& tokens) const;  // the encoder, no autograd: [B, T+1, L]
+  at::Tensor contact_cue_of(const at::Tensor& object, const at::Tensor& contact) const;
 };
 TORCH_MODULE(Denoiser);
 

@@ -197,7 +197,7 @@ TrainConfig load_train_config(const std::string& path) {
     c.text = s.str();
   }
   check_keys(path, root, "the training config",
-             {"model", "data", "out", "export", "variant", "stride", "network", "diffusion", "training"});
+             {"model", "data", "out", "export", "init", "variant", "stride", "network", "diffusion", "training"});
   read(path, root, "model", c.model);
   if (c.model != "contact" && c.model != "motion")
     throw Error(where(path, root["model"] ? root["model"] : root) + ": 'model' must be contact or motion");
@@ -205,11 +205,13 @@ TrainConfig load_train_config(const std::string& path) {
   read(path, root, "data", c.data);
   read(path, root, "out", c.out);
   read(path, root, "export", c.export_path);
+  read(path, root, "init", c.init);
   read(path, root, "variant", c.variant);
   read(path, root, "stride", c.stride);
   if (const YAML::Node n = root["network"]) {
     check_keys(path, n, "network",
-               {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank"});
+               {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank",
+                "contact_cue"});
     read(path, n, "latent", c.network.latent);
     read(path, n, "layers", c.network.layers);
     read(path, n, "heads", c.network.heads);
@@ -218,6 +220,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "dropout", c.network.dropout);
     read(path, n, "output", c.network.output);
     read(path, n, "skip_rank", c.network.skip_rank);
+    read(path, n, "contact_cue", c.network.contact_cue);
   }
   if (const YAML::Node n = root["diffusion"]) {
     check_keys(path, n, "diffusion", {"schedule", "steps"});
@@ -367,6 +370,29 @@ std::string data_fingerprint(const std::string& folder) {
   return buf;
 }
 
+int warm_start(torch::nn::Module& net, const std::map<std::string, at::Tensor>& weights) {
+  torch::NoGradGuard ng;
+  int copied = 0;
+  for (auto& p : net.named_parameters()) {
+    const auto it = weights.find(p.key());
+    if (it == weights.end()) continue;
+    const at::Tensor& from = it->second;
+    at::Tensor to = p.value();
+    if (from.sizes().equals(to.sizes())) {
+      to.copy_(from);
+    } else if (from.dim() == 2 && to.dim() == 2 && from.size(0) == to.size(0) && from.size(1) < to.size(1)) {
+      to.slice(1, 0, from.size(1)).copy_(from);  // the old inputs; the new ones start at zero
+      to.slice(1, from.size(1)).zero_();
+    } else {
+      log::warn("init: '{}' is {} here and {} in the initial model: left at random", p.key(),
+                c10::str(to.sizes()), c10::str(from.sizes()));
+      continue;
+    }
+    ++copied;
+  }
+  return copied;
+}
+
 // ---- the loop ----
 
 TrainResult train(const TrainConfig& config, const TrainOptions& options) {
@@ -426,11 +452,23 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   torch::manual_seed(config.seed);
   Denoiser net(config.network);
   Denoiser ema_net(config.network);
+  if (!config.init.empty() && !options.resume) {
+    const Checkpoint ck = load_checkpoint(config.init);
+    check_compatible(ck.info, config.init, config.model, config.variant, info.basis_points, info.keypoints);
+    const int copied = warm_start(*net, ck.weights);
+    if (show) log::info("initialised {} of {} parameters from {}", copied, net->named_parameters().size(), config.init);
+  }
   load_state(*ema_net, state_of(*net), "EMA copy");
   if (config.network.output != "x0") {
     const auto [directions, variances] = fit_gaussian_skip(config, stats, train_set);
     net->set_gaussian_skip(directions, variances);
     ema_net->set_gaussian_skip(directions, variances);
+  }
+  if (config.network.contact_cue) {
+    const bool scaled = parse_bps_variant(config.variant) != BpsVariant::Uniform;
+    for (Denoiser* n : {&net, &ema_net})
+      (*n)->set_cue_frame(stats.obj_mean.to(at::kFloat), stats.obj_std.to(at::kFloat), stats.c_mean.to(at::kFloat),
+                          stats.c_std.to(at::kFloat), info.basis_points, scaled);
   }
   init_lock.unlock();
   ema_net->eval();

@@ -33,6 +33,10 @@ struct TrainConfig {
   std::string data;        // data set folder (core/data/manifest.h)
   std::string out;         // run folder: checkpoint.npz, loss.csv
   std::string export_path; // the sampling model (EMA weights only) written with each checkpoint; "" = none
+  // A model to start from instead of random weights (not used on --resume): parameters of
+  // the same name and shape are copied; a Linear weight that gained input columns (e.g.
+  // the contact cue) keeps the old ones and gets zeros in the new. "" = random start.
+  std::string init;
   std::string variant = "np_bps";
   int stride = 16;         // window stride of the training windows
   DenoiserConfig network;
@@ -99,6 +103,11 @@ struct StepInputs {
 };
 // What a model denoises, normalised: the contact maps C [B, T, 2048] ("contact") or the
 // hand features X [B, T, 1200] ("motion") of a batch.
+// Copies `weights` into net's parameters of the same name (TrainConfig::init): equal
+// shapes as they are; a 2-D weight with more columns here gets the old columns and zeros.
+// Others are left as they are, with a warning. Returns the number copied.
+int warm_start(torch::nn::Module& net, const std::map<std::string, at::Tensor>& weights);
+
 at::Tensor normalized_sample(const std::string& model, const NormalizationStats& stats, const WindowBatch& batch);
 // Builds StepInputs from a batch: normalisation, and noise, steps and contact dropout
 // drawn from `gen`.

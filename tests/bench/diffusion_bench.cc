@@ -127,5 +127,34 @@ void BM_DiffusionGuidanceStep(benchmark::State& state) {
 }
 BENCHMARK(BM_DiffusionGuidanceStep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// One denoiser forward over a 64-frame window (conditions encoded once, as in sampling).
+// args: size, batch (2 = a CFG pair), fused (1 = the sampling path, 0 = libtorch's module).
+void BM_DiffusionDenoiserForward(benchmark::State& state) {
+  runtime::set_threads(2);
+  DenoiserConfig c = sized("motion", static_cast<int>(state.range(0)));
+  c.dropout = 0.0;
+  torch::manual_seed(1);
+  Denoiser net(c);
+  net->eval();
+  const int64_t B = state.range(1);
+  const bool fused = state.range(2) != 0;
+  torch::NoGradGuard ng;
+  const at::Tensor cond = net->encode_conditions(at::randn({B, 64, c.object_condition_size}));
+  const at::Tensor x = at::randn({B, 64, c.sample_size}), t = at::full({B}, 10, at::kLong);
+  if (!fused) net->train();  // the module path (dropout is 0, so the same numbers)
+  for (auto _ : state) benchmark::DoNotOptimize(net->forward(x, t, cond));
+  state.SetLabel(std::string(size_name(static_cast<int>(state.range(0)))) + ", batch " + std::to_string(B) +
+                 (fused ? ", fused layers" : ", module layers"));
+}
+BENCHMARK(BM_DiffusionDenoiserForward)
+    ->Args({1, 1, 1})
+    ->Args({1, 1, 0})
+    ->Args({1, 2, 1})
+    ->Args({1, 2, 0})
+    ->Args({3, 2, 1})
+    ->Args({3, 2, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 }  // namespace
 }  // namespace bimart::diffusion

@@ -93,6 +93,30 @@ TEST(Checkpoint, OutputKindRoundTripsAndOlderFilesPredictX0) {
   EXPECT_EQ(load_checkpoint(old_path).info.network.output, "x0");
 }
 
+TEST(Checkpoint, ContactCueRoundTripsWithItsFrame) {
+  Checkpoint c = tiny_checkpoint();
+  c.info.network = DenoiserConfig::paper("motion");
+  c.info.network.latent = 16;
+  c.info.network.layers = 1;
+  c.info.network.heads = 2;
+  c.info.network.feedforward = 16;
+  c.info.network.condition_hidden = 8;
+  c.info.network.contact_cue = true;
+  Denoiser net(c.info.network);
+  net->set_cue_frame(at::zeros({3079}), at::full({3079}, 2.0), at::zeros({2048}), at::ones({2048}), c.info.basis_points,
+                     false);
+  c.weights = state_of(*net);
+  const std::string path = scratch("cue.npz");
+  save_checkpoint(c, path);
+  const Checkpoint r = load_checkpoint(path);
+  EXPECT_TRUE(r.info.network.contact_cue);
+  const Denoiser back = make_denoiser(r, path);
+  EXPECT_TRUE(at::equal(back->named_buffers()["cue_basis"], c.info.basis_points));
+  EXPECT_EQ(back->named_buffers()["cue_scaled"].item<float>(), 0.0f);
+  save_checkpoint(tiny_checkpoint(), scratch("plain.npz"));
+  EXPECT_FALSE(load_checkpoint(scratch("plain.npz")).info.network.contact_cue);
+}
+
 TEST(Checkpoint, MismatchesNameWhatDiffers) {
   const Checkpoint c = tiny_checkpoint();
   EXPECT_NO_THROW(check_compatible(c.info, "m.npz", "contact", "np_bps", c.info.basis_points, c.info.keypoints));

@@ -199,6 +199,66 @@ TEST(Denoiser, NullTokenReplacesTheContactCondition) {
   EXPECT_TRUE(at::allclose(mixed[1], net->encode_conditions(obj)[1]));
 }
 
+// A small motion model with the real condition sizes, which the contact cue needs.
+DenoiserConfig small_cue_model(bool cue) {
+  DenoiserConfig c = tiny("motion");
+  c.object_condition_size = 3079;
+  c.contact_condition_size = 2048;
+  c.contact_cue = cue;
+  return c;
+}
+
+TEST(Denoiser, ContactCueReadsTheInputsBeforeNormalisation) {
+  // Raw object features and contact maps, normalised with two different frames: a model
+  // that sees C only through the cue (C's own input columns zeroed, the object MLP's output
+  // zeroed) must give the same conditions for both.
+  torch::manual_seed(4);
+  Denoiser net(small_cue_model(true));
+  torch::NoGradGuard ng;
+  auto& first = *net->named_parameters().find("contact_mlp.0.weight");
+  first.slice(1, 0, 2048).zero_();
+  for (const char* name : {"object_mlp.4.weight", "object_mlp.4.bias"}) net->named_parameters().find(name)->zero_();
+  at::Tensor obj = at::randn({2, 8, 3079}) * 0.1;
+  obj.select(2, 3078).fill_(2.5);                  // s_o
+  const at::Tensor C = at::rand({2, 8, 2048}) * 0.2;  // metres
+  const at::Tensor basis = at::randn({1024, 3}) * 0.5;
+  at::Tensor conds[2];
+  for (int k = 0; k < 2; ++k) {
+    const at::Tensor om = at::randn({3079}) * 0.1, os = at::rand({3079}) + 0.5;
+    const at::Tensor cm = at::rand({2048}) * 0.1, cs = at::rand({2048}) + 0.5;
+    net->set_cue_frame(om, os, cm, cs, basis, true);
+    conds[k] = net->encode_conditions((obj - om) / os, (C - cm) / cs);
+  }
+  EXPECT_TRUE(at::allclose(conds[0], conds[1], 1e-4, 1e-5)) << (conds[0] - conds[1]).abs().max().item<float>();
+  // ... and the cue does enter: a different contact map changes the conditions.
+  EXPECT_FALSE(at::allclose(conds[1], net->encode_conditions(obj, C.flip(2)), 1e-4, 1e-5));
+  EXPECT_THROW(net->set_cue_frame(at::zeros({3}), at::ones({3079}), at::zeros({2048}), at::ones({2048}), basis, true),
+               Error);
+  EXPECT_THROW(Denoiser(small_cue_model(true))->encode_conditions(at::zeros({1, 4, 10})), Error);
+}
+
+TEST(Denoiser, FusedSamplingPathEqualsTheModule) {
+  // Without autograd in eval mode the encoder runs as ATen's fused layer kernel; with
+  // autograd (training) as libtorch's module. Same numbers, paper size included.
+  for (const bool paper : {false, true}) {
+    torch::manual_seed(6);
+    DenoiserConfig c = paper ? DenoiserConfig::paper("motion") : tiny("motion");
+    Denoiser net(c);
+    net->eval();
+    const int T = paper ? 64 : 7;
+    const at::Tensor x = at::randn({3, T, c.sample_size}), t = at::tensor({0, 17, 49});
+    const at::Tensor obj = at::randn({3, T, c.object_condition_size});
+    const at::Tensor module = net->forward(x, t, net->encode_conditions(obj)).detach();
+    at::Tensor fused;
+    {
+      torch::NoGradGuard ng;
+      fused = net->forward(x, t, net->encode_conditions(obj));
+    }
+    EXPECT_LT((fused - module).abs().max().item<float>(), 2e-4 * module.abs().max().item<float>()) << paper;
+    EXPECT_GT(module.abs().max().item<float>(), 0.1f);
+  }
+}
+
 TEST(Denoiser, TimestepEmbeddingIsSinusoidal) {
   const at::Tensor e = timestep_embedding(at::tensor({0, 7}, at::kLong), 8);
   EXPECT_NEAR(e[0][0].item<float>(), 0.0f, 1e-7);        // sin(0)

@@ -98,6 +98,32 @@ TEST(Training, ConfigFileErrorsNameTheLine) {
   EXPECT_THROW(load_train_config(bad.string()), Error);  // 7 does not divide 512
 }
 
+TEST(Training, WarmStartFromAModelWithoutTheContactCueKeepsItsOutput) {
+  // The cue adds input columns to the contact MLP; they start at zero, so the warm-started
+  // model computes what the old one did, whatever the cue says.
+  DenoiserConfig old_config = tiny_config("/unused").network;
+  old_config.dropout = 0;
+  DenoiserConfig new_config = old_config;
+  new_config.contact_cue = true;
+  torch::manual_seed(5);
+  Denoiser old_net(old_config), new_net(new_config);
+  EXPECT_EQ(warm_start(*new_net, state_of(*old_net)), static_cast<int>(new_net->named_parameters().size()));
+  torch::NoGradGuard ng;
+  new_net->set_cue_frame(at::zeros({3079}), at::ones({3079}), at::zeros({2048}), at::ones({2048}),
+                         at::randn({1024, 3}), true);
+  at::Tensor obj = at::randn({2, 4, 3079});
+  obj.select(2, 3078).fill_(2.0);
+  const at::Tensor C = at::rand({2, 4, 2048}), x = at::randn({2, 4, 1200}), t = at::tensor({3, 40});
+  EXPECT_TRUE(at::allclose(new_net->encode_conditions(obj, C), old_net->encode_conditions(obj, C), 1e-5, 1e-6));
+  EXPECT_TRUE(at::allclose(new_net->forward(x, t, new_net->encode_conditions(obj, C)),
+                           old_net->forward(x, t, old_net->encode_conditions(obj, C)), 1e-4, 1e-5));
+  // A parameter of another shape is left as it was.
+  DenoiserConfig wider = old_config;
+  wider.condition_hidden = 24;
+  Denoiser other(wider);
+  EXPECT_LT(warm_start(*other, state_of(*old_net)), static_cast<int>(other->named_parameters().size()));
+}
+
 TEST(Training, LearningRateWarmsUpThenDecays) {
   TrainConfig c;
   c.lr = 1e-3;

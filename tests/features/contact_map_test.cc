@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/features/bps.h"
+#include "core/features/contact_cue.h"
 #include "core/object/families/families.h"
 #include "core/object/object_state.h"
 #include "core/util/data_path.h"
@@ -67,7 +68,7 @@ TEST(ContactMap, HitPointsAreTheEncodersHitVertices) {
   const at::Tensor p = basis_hit_points(o, s, e.hit_indices);
   ASSERT_EQ(p.sizes(), (at::IntArrayRef{2, 1024, 3}));
   // Scaled by s_o, a hit point is basis point + feature.
-  const at::Tensor expected = (e.basis_points.unsqueeze(0) + e.features) / e.scale;
+  const at::Tensor expected = object_points_from_bps(e.features, e.basis_points, at::scalar_tensor(e.scale));
   EXPECT_LT((p - expected).abs().max().item<float>(), 1e-5);
 }
 
