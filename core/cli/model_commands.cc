@@ -20,6 +20,8 @@
 #include "core/cli/command.h"
 #include "core/data/normalization.h"
 #include "core/data/window_dataset.h"
+#include "core/features/contact_cue.h"
+#include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/training.h"
 #include "core/diffusion/generation.h"
 #include "core/diffusion/sampler.h"
@@ -33,7 +35,7 @@ struct CheckArgs {
   std::string checkpoint, dataset, split = "train", sampler = "ddpm", expert;
   int windows = 16, steps = 0, from = -1, expert_from = 40;
   long long seed = 1;
-  double cfg = 0.5;
+  double cfg = 0.5, guidance = 0;
   bool sample = false, no_contact = false;
 };
 
@@ -109,7 +111,13 @@ int run_check(const CheckArgs& a) {
     std::vector<at::Tensor> outs;
     for (int i = 0; i < n; ++i) {
       const at::Tensor C = motion && !a.no_contact ? b.contact_maps[i] : at::Tensor();
-      outs.push_back(model->generate(b.object_features[i], b.global_states[i], C, nullptr, g, gen)[0]);
+      std::unique_ptr<diffusion::ContactMapGuidance> guidance;
+      if (motion && a.guidance > 0) {  // towards the ground-truth maps
+        const at::Tensor points = object_points_from_bps(b.object_features[i], data.basis_points(),
+                                                         b.global_states[i].select(1, 6));
+        guidance = std::make_unique<diffusion::ContactMapGuidance>(points, b.contact_maps[i], a.guidance);
+      }
+      outs.push_back(model->generate(b.object_features[i], b.global_states[i], C, guidance.get(), g, gen)[0]);
     }
     sm = motion ? at::stack(outs, 0) : at::stack(outs, 0).flatten(-2);
   } else {  // all windows in one batch: from noise, or from the truth noised to step `from`
@@ -152,6 +160,16 @@ int run_check(const CheckArgs& a) {
     std::cout << fmt::format("  hand centroid error {:.2f} mm; keypoints with the centroids matched {:.2f} mm\n",
                              1000.0 * (cs - ct).norm(2, -1).mean().item<double>(),
                              1000.0 * ((hs - cs) - (ht - ct)).norm(2, -1).mean().item<double>());
+    // Hands touching the object (ground-truth contact map below 1 cm somewhere) vs apart.
+    const at::Tensor touching = std::get<0>(b.contact_maps.min(-1)) < 0.01;  // [n, T, 2]
+    const at::Tensor per_hand = (hs - ht).norm(2, -1).mean(-1);               // [n, T, 2]
+    const auto share_mean = [&](const at::Tensor& m) {
+      const double k = m.sum().item<double>();
+      return k > 0 ? 1000.0 * (per_hand * m).sum().item<double>() / k : NAN;
+    };
+    std::cout << fmt::format("  hands touching the object ({:.0f} % of hand-frames): {:.2f} mm; apart: {:.2f} mm\n",
+                             100.0 * touching.to(at::kDouble).mean().item<double>(), share_mean(touching.to(at::kFloat)),
+                             share_mean((~touching).to(at::kFloat)));
     std::cout << fmt::format("  keypoint Accel (H): sample {:.3f} mm/frame², ground truth {:.3f}\n",
                              1000.0 * acceleration(sm.slice(2, 0, 600)), 1000.0 * acceleration(truth.slice(2, 0, 600)));
   } else {
@@ -183,6 +201,9 @@ void add_model_commands(CLI::App& app, Commands& out) {
   check->add_option("--expert", a->expert, "Experimental: another checkpoint of the same model for the noisiest steps")
       ->check(CLI::ExistingFile);
   check->add_option("--expert-from", a->expert_from, "The expert takes the steps t >= this")->capture_default_str();
+  check->add_option("--guidance", a->guidance,
+                    "Motion model, with --sample: contact-map guidance towards the ground-truth maps at this scale (0 = off)")
+      ->capture_default_str();
   check->add_flag("--no-contact", a->no_contact, "Motion model: the null contact token instead of the maps");
   out.push_back({check, [a] { return run_check(*a); }, false});
 }
