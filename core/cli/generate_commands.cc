@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 
@@ -41,6 +42,7 @@ struct GenerateArgs {
   std::string dataset, split = "test", out, pipeline = "pipelines/generate_eval.yaml";
   int samples = 10, window = 64;
   long long limit = 0, seed = 0;
+  bool resume = false;
   std::vector<std::string> overrides;
 };
 
@@ -174,9 +176,38 @@ int run_generate(const GenerateArgs& a) {
   std::int64_t residual_count = 0;
   const auto t0 = std::chrono::steady_clock::now();
   ProgressBar bar("generate", windows.size(), true);
+  std::size_t reused = 0;
+  // What a window's record must match to be kept by --resume.
+  const nlohmann::json run_key{{"pipeline", a.pipeline}, {"set", a.overrides}, {"seed", a.seed}, {"samples", a.samples}};
   for (const auto& w : windows) {
     nlohmann::json jw{{"name", w.name}, {"category", w.category}, {"start", w.start}, {"frames", w.length},
                       {"ground_truth", fs::relative(w.source, out).string()}};
+    const std::string stem = fs::path(w.source).stem().string();
+    // Each finished window leaves a record; --resume keeps a window whose record and sample
+    // files all exist (every window's run is seeded alone, so the result is the same).
+    const fs::path record = out / "windows" / (stem + ".json");
+    if (a.resume && fs::exists(record)) {
+      bool complete = true;
+      for (const auto& e : exports)
+        for (int k = 0; k < a.samples; ++k)
+          complete = complete && fs::exists(out / e / fmt::format("{}_s{:02d}.npz", stem, k));
+      if (complete) {
+        std::ifstream in(record);
+        const nlohmann::json kept = nlohmann::json::parse(in, nullptr, false);
+        if (!kept.is_discarded() && kept.contains("run") && kept["run"] == run_key) {
+          jw = kept;
+          jw.erase("run");
+          for (const auto& mm : jw.value("fit_residual_mm", nlohmann::json::array())) {
+            residual_sum += mm.get<double>() / 1e3;
+            ++residual_count;
+          }
+          summary["windows"].push_back(jw);
+          ++reused;
+          bar.step();
+          continue;
+        }
+      }
+    }
     // One run per window draws all its samples as one batch; each export.sequence stage
     // writes one file per sample (stages/samples.h).
     GraphFile file = proto;
@@ -184,7 +215,6 @@ int run_generate(const GenerateArgs& a) {
     for (const auto& id : sampling_ids) file.apply_override(id + ".samples=" + std::to_string(a.samples));
     for (const auto& o : a.overrides) file.apply_override(o);
     file.apply_override(trajectory_id + ".path=" + w.source);
-    const std::string stem = fs::path(w.source).stem().string();
     for (const auto& e : exports)
       file.apply_override(e + ".path=" + (out / e / (stem + "_s{sample:02d}.npz")).string());
     file.seed = static_cast<std::uint64_t>(a.seed);
@@ -206,9 +236,14 @@ int run_generate(const GenerateArgs& a) {
         ++residual_count;
       }
     }
+    nlohmann::json rec = jw;
+    rec["run"] = run_key;
+    fs::create_directories(record.parent_path());
+    write_file_atomically(record.string(), [&](std::ostream& o) { o << rec.dump(2) << "\n"; });
     bar.step();
     summary["windows"].push_back(jw);
   }
+  if (reused > 0) log::info("generate: {} of {} windows were already done (--resume)", reused, windows.size());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   summary["seconds"] = seconds;
   if (residual_count > 0) summary["mean_fit_residual_mm"] = 1e3 * residual_sum / residual_count;
@@ -238,6 +273,8 @@ void add_generate_commands(CLI::App& app, Commands& out) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--window", a.window, "frames per window")->check(CLI::Range(2, 100000));
   cmd->add_option("--set", a.overrides, "override a parameter: stage.param=value (repeatable)");
+  cmd->add_flag("--resume", a.resume,
+                "keep the windows an earlier run of the same command finished (DIR/windows/*.json and all their samples)");
   cmd->add_option("--seed", a.seed, "seed of every window's run (its samples are drawn as one batch)")->check(CLI::NonNegativeNumber);
   out.push_back({cmd, [] { return run_generate(a); }});
 }

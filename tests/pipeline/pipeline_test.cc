@@ -171,6 +171,26 @@ TEST_F(ShippedPipeline, GenerateDrawsAWindowsSamplesInOneRun) {
   const test::CliRun e = test::run_bimart("-q eval " + (out / "refined").string());
   ASSERT_EQ(exit_code(e), 0) << e.output;
   EXPECT_HAS(e.output, "2 sequences, 1 trajectories, 1 with several samples");
+
+  // --resume keeps the finished window (its files untouched, its residuals in the summary)...
+  const std::string again = "generate " + data.string() + " --samples 2 --window 32 --out " + out.string() +
+                            " --pipeline " + kSource + "/pipelines/generate_eval.yaml" + kFewSteps + " --resume";
+  const fs::path s1 = out / "refined" / "sample_0_f022_s01.npz";
+  const auto written = fs::last_write_time(s1);
+  const test::CliRun kept = test::run_bimart(again);
+  ASSERT_EQ(exit_code(kept), 0) << kept.output;
+  EXPECT_HAS(kept.output, "1 of 1 windows were already done (--resume)");
+  EXPECT_EQ(fs::last_write_time(s1), written);
+  EXPECT_EQ(nlohmann::json::parse(read(out / "generate.json"))["mean_fit_residual_mm"], j["mean_fit_residual_mm"]);
+  // ... but runs it again when a sample file is missing, or the command differs.
+  fs::remove(s1);
+  const test::CliRun redo = test::run_bimart(again);
+  ASSERT_EQ(exit_code(redo), 0) << redo.output;
+  EXPECT_TRUE(fs::exists(s1));
+  EXPECT_EQ(redo.output.find("already done"), std::string::npos) << redo.output;
+  const test::CliRun other = test::run_bimart(again + " --seed 3");
+  ASSERT_EQ(exit_code(other), 0) << other.output;
+  EXPECT_EQ(other.output.find("already done"), std::string::npos) << other.output;
 }
 
 // User errors: exit code 1, the file named, nothing written.
