@@ -20,12 +20,12 @@
 #include "core/cli/command.h"
 #include "core/data/normalization.h"
 #include "core/data/window_dataset.h"
-#include "core/features/contact_cue.h"
 #include "core/diffusion/contact_guidance.h"
-#include "core/diffusion/training.h"
 #include "core/diffusion/generation.h"
 #include "core/diffusion/sampler.h"
 #include "core/diffusion/schedule.h"
+#include "core/diffusion/training.h"
+#include "core/features/contact_cue.h"
 #include "core/util/error.h"
 
 namespace bimart::cli {

@@ -150,7 +150,7 @@ at::Tensor DenoiserImpl::contact_cue_of(const at::Tensor& object, const at::Tens
   const at::Tensor obj = object * cue_object_std_ + cue_object_mean_;  // [B, T, 3079]
   const at::Tensor O = obj.slice(2, 0, 3072).reshape({B, T, 1024, 3});
   const at::Tensor s_o = obj.select(2, 3078);                          // G's last entry
-  const at::Tensor scale = cue_scaled_.item<float>() > 0.5f ? s_o : at::ones_like(s_o);
+  const at::Tensor scale = s_o * cue_scaled_ + (1.0 - cue_scaled_);  // s_o, or 1 for U-BPS
   const at::Tensor C = (contact * cue_contact_std_ + cue_contact_mean_).view({B, T, 2, 1024});
   return contact_cue(object_points_from_bps(O, cue_basis_, scale), C);
 }
@@ -249,8 +249,8 @@ at::Tensor DenoiserImpl::forward(const at::Tensor& x_t, const at::Tensor& t, con
   const at::Tensor step = time_mlp_->forward(timestep_embedding(t, config_.latent)).unsqueeze(1);
   const at::Tensor tokens = torch::cat({step, frames}, 1) + positions_.slice(0, 0, T + 1).unsqueeze(0);
   // Sampling (no autograd, eval mode) runs each layer as ATen's fused encoder-layer kernel
-  // (the one PyTorch's Python fast path calls): ~10 ops per layer where the module runs ~60,
-  // and at this size the time goes to op overhead. Training uses the module.
+  // (the one PyTorch's Python fast path calls): fewer ops per layer, 3-7 % faster at the
+  // default size (the rest is GEMM, docs/performance.md). Training uses the module.
   const bool fused = !is_training() && !at::GradMode::is_enabled();
   // libtorch's encoder module takes [sequence, batch, latent]; the fused kernel batch first.
   const at::Tensor encoded = fused ? encode_fused(tokens) : encoder_->forward(tokens.transpose(0, 1)).transpose(0, 1);
