@@ -75,6 +75,8 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   set_string(f, "network/output", i.network.output);
   f.set("network/skip_rank", make_npy_scalar<std::int64_t>(i.network.skip_rank));
   f.set("network/contact_cue", make_npy_scalar<std::int64_t>(i.network.contact_cue ? 1 : 0));
+  f.set("network/contact_points", make_npy_scalar<std::int64_t>(i.network.contact_points));
+  f.set("network/point_hidden", make_npy_scalar<std::int64_t>(i.network.point_hidden));
   set_string(f, "diffusion/schedule", i.schedule);
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
   set_string(f, "encoder/variant", i.variant);
@@ -124,6 +126,14 @@ Checkpoint load_checkpoint(const std::string& path) {
   }
   // Checkpoints from before the contact cue have none.
   i.network.contact_cue = f.contains("network/contact_cue") && get_int(f, "network/contact_cue") != 0;
+  // ... and from before the contact points none (validate checks the range).
+  for (const auto& [key, member] : {std::pair{"network/contact_points", &DenoiserConfig::contact_points},
+                                    std::pair{"network/point_hidden", &DenoiserConfig::point_hidden}})
+    if (f.contains(key)) {
+      const std::int64_t v = get_int(f, key);
+      if (v < 0 || v > (1 << 24)) throw Error(f.where(key) + ": out of range");
+      i.network.*member = static_cast<int>(v);
+    }
   try {
     i.network.validate();
   } catch (const Error& e) {

@@ -63,6 +63,11 @@ void DenoiserConfig::validate() const {
   require(skip_rank >= 1 && skip_rank <= 65536, "skip_rank", "must be in [1, 65536]");
   require(!contact_cue || (model == "motion" && contact_condition_size == 2 * 1024 && object_condition_size == 3079),
           "contact_cue", "needs the motion model with contact maps [2, 1024] and object features [1024, 3 | 7]");
+  require(contact_points >= 0 && contact_points <= 1024, "contact_points", "must be in [0, 1024]");
+  require(contact_points == 0 ||
+              (model == "motion" && contact_condition_size == 2 * 1024 && object_condition_size == 3079),
+          "contact_points", "needs the motion model with contact maps [2, 1024] and object features [1024, 3 | 7]");
+  require(point_hidden >= 1, "point_hidden", "must be positive");
 }
 
 std::string DenoiserConfig::describe() const {
@@ -70,6 +75,9 @@ std::string DenoiserConfig::describe() const {
          " layers, " + std::to_string(heads) + " heads, feed-forward " + std::to_string(feedforward) +
          ", condition MLPs " + std::to_string(condition_hidden) + ", window " + std::to_string(window) +
          (contact_cue ? ", contact cue" : "") +
+         (contact_points > 0 ? ", contact points " + std::to_string(contact_points) + " (MLP " +
+                                   std::to_string(point_hidden) + ")"
+                             : "") +
          (output != "x0" ? ", " + output + ", Gaussian skip of rank " + std::to_string(std::min(skip_rank, sample_size)) : "");
 }
 
@@ -133,7 +141,7 @@ void DenoiserImpl::set_gaussian_skip(const at::Tensor& directions, const at::Ten
 void DenoiserImpl::set_cue_frame(const at::Tensor& object_mean, const at::Tensor& object_std,
                                  const at::Tensor& contact_mean, const at::Tensor& contact_std,
                                  const at::Tensor& basis_points, bool scaled) {
-  if (!config_.contact_cue) throw Error("denoiser: set_cue_frame on a model without the contact cue");
+  if (!reads_object_points()) throw Error("denoiser: set_cue_frame on a model without the contact cue or points");
   const std::vector<std::pair<const at::Tensor*, at::Tensor*>> pairs = {
       {&object_mean, &cue_object_mean_}, {&object_std, &cue_object_std_}, {&contact_mean, &cue_contact_mean_},
       {&contact_std, &cue_contact_std_}, {&basis_points, &cue_basis_}};
@@ -145,14 +153,14 @@ void DenoiserImpl::set_cue_frame(const at::Tensor& object_mean, const at::Tensor
   cue_scaled_.fill_(scaled ? 1.0 : 0.0);
 }
 
-at::Tensor DenoiserImpl::contact_cue_of(const at::Tensor& object, const at::Tensor& contact) const {
+DenoiserImpl::ObjectContact DenoiserImpl::object_contact_of(const at::Tensor& object, const at::Tensor& contact) const {
   const auto B = object.size(0), T = object.size(1);
   const at::Tensor obj = object * cue_object_std_ + cue_object_mean_;  // [B, T, 3079]
   const at::Tensor O = obj.slice(2, 0, 3072).reshape({B, T, 1024, 3});
   const at::Tensor s_o = obj.select(2, 3078);                          // G's last entry
   const at::Tensor scale = s_o * cue_scaled_ + (1.0 - cue_scaled_);  // s_o, or 1 for U-BPS
   const at::Tensor C = (contact * cue_contact_std_ + cue_contact_mean_).view({B, T, 2, 1024});
-  return contact_cue(object_points_from_bps(O, cue_basis_, scale), C);
+  return {object_points_from_bps(O, cue_basis_, scale), O, C};
 }
 
 at::Tensor timestep_embedding(const at::Tensor& t, int dim) {
@@ -191,7 +199,10 @@ DenoiserImpl::DenoiserImpl(const DenoiserConfig& config) : config_(config) {
   encoder_ = register_module(
       "encoder", torch::nn::TransformerEncoder(torch::nn::TransformerEncoderOptions(layer, config_.layers)));
   positions_ = register_buffer("positions", sinusoidal_positions(config_.window + 1, L));
-  if (config_.contact_cue) {
+  if (config_.contact_points > 0)
+    contact_points_ = register_module("contact_points",
+                                      ContactPointEncoder(config_.contact_points, config_.point_hidden, L));
+  if (reads_object_points()) {
     cue_object_mean_ = register_buffer("cue_object_mean", torch::zeros({config_.object_condition_size}));
     cue_object_std_ = register_buffer("cue_object_std", torch::ones({config_.object_condition_size}));
     cue_contact_mean_ = register_buffer("cue_contact_mean", torch::zeros({config_.contact_condition_size}));
@@ -228,8 +239,15 @@ at::Tensor DenoiserImpl::encode_conditions(const at::Tensor& object, const at::T
     throw Error("denoiser: contact condition must be [" + std::to_string(B) + ", " + std::to_string(T) +
                 ", " + std::to_string(config_.contact_condition_size) + "], got " + c10::str(contact.sizes()));
   }
-  const at::Tensor c = contact_mlp_->forward(
-      config_.contact_cue ? torch::cat({contact, contact_cue_of(object, contact)}, -1) : contact);
+  at::Tensor c;
+  if (reads_object_points()) {
+    const ObjectContact in = object_contact_of(object, contact);
+    c = contact_mlp_->forward(config_.contact_cue ? torch::cat({contact, contact_cue(in.points, in.maps)}, -1)
+                                                  : contact);
+    if (contact_points_) c = c + contact_points_->forward(in.points, in.offsets, in.maps);
+  } else {
+    c = contact_mlp_->forward(contact);
+  }
   if (!use_contact.defined()) return cond + c;
   const at::Tensor keep = use_contact.to(torch::kBool).view({B, 1, 1});
   return cond + torch::where(keep, c, null);

@@ -19,6 +19,8 @@
 #include <torch/nn/modules/linear.h>
 #include <torch/nn/modules/transformercoder.h>
 
+#include "core/diffusion/contact_point_encoder.h"
+
 namespace bimart::diffusion {
 
 struct DenoiserConfig {
@@ -49,6 +51,11 @@ struct DenoiserConfig {
   // computed inside encode_conditions from the normalised inputs with the frame set by
   // set_cue_frame (stored with the weights).
   bool contact_cue = false;
+  // Motion model: K > 0 adds the contact point encoder (core/diffusion/contact_point_encoder.h)
+  // over each hand's K nearest object points, with a point MLP `point_hidden` wide; its
+  // token is added to the contact MLP's. Uses the same frame as the cue (set_cue_frame).
+  int contact_points = 0;
+  int point_hidden = 128;
 
   // The configuration of a model kind with the paper's size (DESIGN §5).
   static DenoiserConfig paper(const std::string& model);
@@ -75,6 +82,8 @@ class DenoiserImpl : public torch::nn::Module {
   at::Tensor forward(const at::Tensor& x_t, const at::Tensor& t, const at::Tensor& cond);
 
   const DenoiserConfig& config() const { return config_; }
+  // Whether encode_conditions needs the object points, i.e. set_cue_frame (contact cue or points).
+  bool reads_object_points() const { return config_.contact_cue || config_.contact_points > 0; }
   // The skip's directions U [sample, k] (orthonormal columns) and variances λ: [k], or
   // [window, k] per DCT frequency for "temporal" (buffers, stored with the weights). Until
   // set: the first k unit vectors, λ = 1.
@@ -93,14 +102,20 @@ class DenoiserImpl : public torch::nn::Module {
   torch::nn::Linear input_{nullptr}, output_{nullptr};
   torch::nn::Sequential time_mlp_{nullptr}, object_mlp_{nullptr}, contact_mlp_{nullptr};
   torch::nn::TransformerEncoder encoder_{nullptr};
+  ContactPointEncoder contact_points_{nullptr};
   at::Tensor null_contact_;  // [window, latent] parameter (motion model)
   at::Tensor positions_;     // [window + 1, latent] buffer: sinusoidal positions
   at::Tensor skip_directions_, skip_variances_;  // "gaussian" output: [sample, k], [k] buffers
-  // contact_cue: buffers object mean/std [3079], contact mean/std [2048], basis [1024, 3],
-  // scaled [1] (1 = divide by s_o).
+  // contact cue or points: buffers object mean/std [3079], contact mean/std [2048], basis
+  // [1024, 3], scaled [1] (1 = divide by s_o).
   at::Tensor cue_object_mean_, cue_object_std_, cue_contact_mean_, cue_contact_std_, cue_basis_, cue_scaled_;
   at::Tensor encode_fused(const at::Tensor& tokens) const;  // the encoder, no autograd: [B, T+1, L]
-  at::Tensor contact_cue_of(const at::Tensor& object, const at::Tensor& contact) const;
+  // The un-normalised inputs: object points [B, T, 1024, 3] (m), BPS offsets [B, T, 1024, 3]
+  // and contact maps [B, T, 2, 1024] (m) of normalised object / contact conditions.
+  struct ObjectContact {
+    at::Tensor points, offsets, maps;
+  };
+  ObjectContact object_contact_of(const at::Tensor& object, const at::Tensor& contact) const;
 };
 TORCH_MODULE(Denoiser);
 

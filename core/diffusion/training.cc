@@ -211,7 +211,7 @@ TrainConfig load_train_config(const std::string& path) {
   if (const YAML::Node n = root["network"]) {
     check_keys(path, n, "network",
                {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank",
-                "contact_cue"});
+                "contact_cue", "contact_points", "point_hidden"});
     read(path, n, "latent", c.network.latent);
     read(path, n, "layers", c.network.layers);
     read(path, n, "heads", c.network.heads);
@@ -221,6 +221,8 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "output", c.network.output);
     read(path, n, "skip_rank", c.network.skip_rank);
     read(path, n, "contact_cue", c.network.contact_cue);
+    read(path, n, "contact_points", c.network.contact_points);
+    read(path, n, "point_hidden", c.network.point_hidden);
   }
   if (const YAML::Node n = root["diffusion"]) {
     check_keys(path, n, "diffusion", {"schedule", "steps"});
@@ -464,7 +466,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     net->set_gaussian_skip(directions, variances);
     ema_net->set_gaussian_skip(directions, variances);
   }
-  if (config.network.contact_cue) {
+  if (net->reads_object_points()) {
     const bool scaled = parse_bps_variant(config.variant) != BpsVariant::Uniform;
     for (Denoiser* n : {&net, &ema_net})
       (*n)->set_cue_frame(stats.obj_mean.to(at::kFloat), stats.obj_std.to(at::kFloat), stats.c_mean.to(at::kFloat),

@@ -102,6 +102,8 @@ TEST(Checkpoint, ContactCueRoundTripsWithItsFrame) {
   c.info.network.feedforward = 16;
   c.info.network.condition_hidden = 8;
   c.info.network.contact_cue = true;
+  c.info.network.contact_points = 16;
+  c.info.network.point_hidden = 8;
   Denoiser net(c.info.network);
   net->set_cue_frame(at::zeros({3079}), at::full({3079}, 2.0), at::zeros({2048}), at::ones({2048}), c.info.basis_points,
                      false);
@@ -110,11 +112,14 @@ TEST(Checkpoint, ContactCueRoundTripsWithItsFrame) {
   save_checkpoint(c, path);
   const Checkpoint r = load_checkpoint(path);
   EXPECT_TRUE(r.info.network.contact_cue);
+  EXPECT_EQ(r.info.network.contact_points, 16);
+  EXPECT_EQ(r.info.network.point_hidden, 8);
   const Denoiser back = make_denoiser(r, path);
   EXPECT_TRUE(at::equal(back->named_buffers()["cue_basis"], c.info.basis_points));
   EXPECT_EQ(back->named_buffers()["cue_scaled"].item<float>(), 0.0f);
   save_checkpoint(tiny_checkpoint(), scratch("plain.npz"));
   EXPECT_FALSE(load_checkpoint(scratch("plain.npz")).info.network.contact_cue);
+  EXPECT_EQ(load_checkpoint(scratch("plain.npz")).info.network.contact_points, 0);
 }
 
 TEST(Checkpoint, MismatchesNameWhatDiffers) {

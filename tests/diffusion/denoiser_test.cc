@@ -237,6 +237,48 @@ TEST(Denoiser, ContactCueReadsTheInputsBeforeNormalisation) {
   EXPECT_THROW(Denoiser(small_cue_model(true))->encode_conditions(at::zeros({1, 4, 10})), Error);
 }
 
+TEST(Denoiser, ContactPointsReadThePointsNearestToEachHand) {
+  // The point encoder reads only each hand's K nearest points: moving a far point's position
+  // or distance changes nothing; moving a near one does. Normalisation frames cancel as for
+  // the cue.
+  torch::manual_seed(5);
+  DenoiserConfig config = small_cue_model(false);
+  config.contact_points = 8;
+  config.point_hidden = 16;
+  Denoiser net(config);
+  torch::NoGradGuard ng;
+  auto& first = *net->named_parameters().find("contact_mlp.0.weight");
+  first.zero_();  // C enters through the point encoder only
+  for (const char* name : {"object_mlp.4.weight", "object_mlp.4.bias"}) net->named_parameters().find(name)->zero_();
+  at::Tensor obj = at::randn({1, 3, 3079}) * 0.1;
+  obj.select(2, 3078).fill_(2.0);
+  at::Tensor C = 0.3 + at::rand({1, 3, 2048}) * 0.2;  // metres, all far ...
+  C.slice(2, 0, 8).fill_(0.01);                          // ... but 8 points near the left hand
+  C.slice(2, 1024 + 100, 1024 + 108).fill_(0.02);        // and 8 near the right
+  const at::Tensor basis = at::randn({1024, 3}) * 0.5;
+  net->set_cue_frame(at::zeros({3079}), at::ones({3079}), at::zeros({2048}), at::ones({2048}), basis, true);
+  const at::Tensor base = net->encode_conditions(obj, C);
+  at::Tensor far = C.clone();
+  far.select(2, 500).add_(0.1);  // a far point's distance
+  at::Tensor moved = obj.clone();
+  moved.select(2, 3 * 600).add_(0.3);  // a far point's position (x of point 600)
+  EXPECT_TRUE(at::allclose(base, net->encode_conditions(obj, far)));
+  EXPECT_TRUE(at::allclose(base, net->encode_conditions(moved, C)));
+  at::Tensor near = obj.clone();
+  near.select(2, 3 * 3).add_(0.3);  // x of point 3, near the left hand
+  EXPECT_FALSE(at::allclose(base, net->encode_conditions(near, C), 1e-4, 1e-5));
+  at::Tensor nearer = C.clone();
+  nearer.select(2, 1024 + 104).fill_(0.0);
+  EXPECT_FALSE(at::allclose(base, net->encode_conditions(obj, nearer), 1e-4, 1e-5));
+  // Normalised inputs give the same conditions once the frame says how they were normalised.
+  const at::Tensor om = at::randn({3079}) * 0.1, os = at::rand({3079}) + 0.5;
+  const at::Tensor cm = at::rand({2048}) * 0.1, cs = at::rand({2048}) + 0.5;
+  net->set_cue_frame(om, os, cm, cs, basis, true);
+  EXPECT_TRUE(at::allclose(base, net->encode_conditions((obj - om) / os, (C - cm) / cs), 1e-4, 1e-5));
+  config.contact_points = 1025;
+  EXPECT_THROW(config.validate(), Error);
+}
+
 TEST(Denoiser, FusedSamplingPathEqualsTheModule) {
   // Without autograd in eval mode the encoder runs as ATen's fused layer kernel; with
   // autograd (training) as libtorch's module. Same numbers, paper size included.
