@@ -231,7 +231,7 @@ TrainConfig load_train_config(const std::string& path) {
   }
   if (const YAML::Node n = root["training"]) {
     check_keys(path, n, "training",
-               {"batch", "steps", "lr", "warmup", "weight_decay", "grad_clip", "ema", "contact_dropout", "seed",
+               {"batch", "steps", "lr", "warmup", "weight_decay", "grad_clip", "ema", "contact_dropout", "noisy_share", "noisy_from", "seed",
                 "checkpoint_every", "validate_every", "validation_windows", "log_every"});
     read(path, n, "batch", c.batch);
     read(path, n, "steps", c.steps);
@@ -241,6 +241,8 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "grad_clip", c.grad_clip);
     read(path, n, "ema", c.ema);
     read(path, n, "contact_dropout", c.contact_dropout);
+    read(path, n, "noisy_share", c.noisy_share);
+    read(path, n, "noisy_from", c.noisy_from);
     read(path, n, "seed", c.seed);
     read(path, n, "checkpoint_every", c.checkpoint_every);
     read(path, n, "validate_every", c.validate_every);
@@ -275,6 +277,9 @@ void validate(const TrainConfig& c) {
   need(c.grad_clip >= 0, "'training.grad_clip' must not be negative");
   need(c.ema >= 0 && c.ema < 1, "'training.ema' must be in [0, 1)");
   need(c.contact_dropout >= 0 && c.contact_dropout <= 1, "'training.contact_dropout' must be in [0, 1]");
+  need(c.noisy_share >= 0 && c.noisy_share <= 1, "'training.noisy_share' must be in [0, 1]");
+  need(c.noisy_from >= 0 && c.noisy_from < c.diffusion_steps,
+       "'training.noisy_from' must be in [0, diffusion.steps), got " + std::to_string(c.noisy_from));
   need(c.checkpoint_every >= 1, "'training.checkpoint_every' must be positive");
   need(c.validate_every >= 0, "'training.validate_every' must not be negative");
   need(c.validation_windows >= 1, "'training.validation_windows' must be positive");
@@ -307,6 +312,10 @@ StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stat
   in.mask = b.mask;
   in.noise = at::randn(in.sample.sizes(), gen);
   in.t = at::randint(0, c.diffusion_steps, {B}, gen, at::kLong);
+  if (c.noisy_share > 0) {  // drawn only then, so that uniform runs keep their random stream
+    const at::Tensor noisy = at::randint(c.noisy_from, c.diffusion_steps, {B}, gen, at::kLong);
+    in.t = at::where(at::rand({B}, gen) < c.noisy_share, noisy, in.t);
+  }
   return in;
 }
 

@@ -50,6 +50,11 @@ struct TrainConfig {
   double grad_clip = 1.0;  // max global gradient norm; 0 = off
   double ema = 0.999;      // EMA decay (warmed up: min(ema, (1 + k) / (10 + k)))
   double contact_dropout = 0.5;  // motion model: P(null contact token) per window
+  // Share of each batch whose diffusion step is drawn from [noisy_from, steps) instead of
+  // all steps (0 = uniform, the paper). The noisiest steps are where the conditions decide
+  // the sample; under uniform steps they get 1/steps of the training each.
+  double noisy_share = 0;
+  int noisy_from = 35;
   std::uint64_t seed = 1;
   int checkpoint_every = 200;    // steps
   int validate_every = 500;      // steps; 0 = never

@@ -124,6 +124,34 @@ TEST(Training, WarmStartFromAModelWithoutTheContactCueKeepsItsOutput) {
   EXPECT_LT(warm_start(*other, state_of(*old_net)), static_cast<int>(other->named_parameters().size()));
 }
 
+TEST(Training, NoisyShareDrawsThatShareOfStepsFromTheNoisiestOnes) {
+  TrainConfig c = tiny_config(scratch("noisy"));
+  c.batch = 20;
+  WindowDatasetOptions wo;
+  const WindowDataset data = WindowDataset::open(c.data, "train", wo);
+  const NormalizationStats stats = compute_normalization(data);
+  const auto share_from = [&](int from) {
+    double n = 0;
+    for (int step = 0; step < 20; ++step) n += (draw_step(c, stats, data, step, 0).t >= from).sum().item<double>();
+    return n / (20.0 * c.batch);
+  };
+  const at::Tensor uniform = draw_step(c, stats, data, 0, 0).t;
+  EXPECT_NEAR(share_from(40), 10.0 / 50.0, 0.07);  // uniform: 10 of 50 steps (400 draws: σ 0.02)
+  c.noisy_share = 0.5;
+  c.noisy_from = 40;
+  // Half from [40, 50), half uniform: P(t >= 40) = 0.5 + 0.5 · 0.2.
+  EXPECT_NEAR(share_from(40), 0.6, 0.07);
+  c.noisy_share = 1.0;  // all from [40, 50)
+  const at::Tensor noisy = draw_step(c, stats, data, 0, 0).t;
+  EXPECT_GE(noisy.min().item<std::int64_t>(), 40);
+  EXPECT_LE(noisy.max().item<std::int64_t>(), 49);
+  // The uniform draw is unchanged by the option's existence.
+  c.noisy_share = 0;
+  EXPECT_TRUE(at::equal(draw_step(c, stats, data, 0, 0).t, uniform));
+  c.noisy_from = 50;
+  EXPECT_THROW(validate(c), Error);
+}
+
 TEST(Training, LearningRateWarmsUpThenDecays) {
   TrainConfig c;
   c.lr = 1e-3;
