@@ -40,7 +40,11 @@ void store_map(NpzFile& f, const std::string& prefix, const TensorMap& m) {
 TensorMap read_map(const NpzFile& f, const std::string& prefix) {
   TensorMap m;
   for (const auto& key : f.keys())
-    if (key.rfind(prefix, 0) == 0) m[key.substr(prefix.size())] = tensor_from_npy(f.get(key), f.where(key));
+    if (key.rfind(prefix, 0) == 0) {
+      const at::Tensor t = tensor_from_npy(f.get(key), f.where(key));
+      // Weights stored as float16 (TrainConfig::export_half) are widened: the network runs in float32.
+      m[key.substr(prefix.size())] = t.scalar_type() == at::kHalf ? t.to(at::kFloat) : t;
+    }
   return m;
 }
 

@@ -197,7 +197,7 @@ TrainConfig load_train_config(const std::string& path) {
     c.text = s.str();
   }
   check_keys(path, root, "the training config",
-             {"model", "data", "out", "export", "init", "variant", "stride", "network", "diffusion", "training"});
+             {"model", "data", "out", "export", "export_half", "init", "variant", "stride", "network", "diffusion", "training"});
   read(path, root, "model", c.model);
   if (c.model != "contact" && c.model != "motion")
     throw Error(where(path, root["model"] ? root["model"] : root) + ": 'model' must be contact or motion");
@@ -205,6 +205,7 @@ TrainConfig load_train_config(const std::string& path) {
   read(path, root, "data", c.data);
   read(path, root, "out", c.out);
   read(path, root, "export", c.export_path);
+  read(path, root, "export_half", c.export_half);
   read(path, root, "init", c.init);
   read(path, root, "variant", c.variant);
   read(path, root, "stride", c.stride);
@@ -535,6 +536,8 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
       Checkpoint release;
       release.info = info;
       release.weights = ck.weights;
+      if (config.export_half)
+        for (const auto& p : ema_net->named_parameters()) release.weights[p.key()] = p.value().detach().to(at::kHalf);
       save_checkpoint(release, config.export_path);
     }
     write_loss_log(log_path, rows);
@@ -641,7 +644,11 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     if (root && (step % config.checkpoint_every == 0 || step == config.steps)) write_checkpoint();
   }
   if (root && steps_this_call > 0 && step % config.checkpoint_every != 0 && step != config.steps) write_checkpoint();
-  if (root && steps_this_call == 0 && !fs::exists(checkpoint_path)) write_checkpoint();
+  // Nothing trained: write what is missing (a finished run resumed rewrites a deleted export,
+  // e.g. to store it with export_half).
+  if (root && steps_this_call == 0 &&
+      (!fs::exists(checkpoint_path) || (!config.export_path.empty() && !fs::exists(config.export_path))))
+    write_checkpoint();
 
   result.steps_done = step;
   result.finished = step >= config.steps;

@@ -33,6 +33,7 @@ struct TrainConfig {
   std::string data;        // data set folder (core/data/manifest.h)
   std::string out;         // run folder: checkpoint.npz, loss.csv
   std::string export_path; // the sampling model (EMA weights only) written with each checkpoint; "" = none
+  bool export_half = false;  // store the export's parameters as float16 (half the file; widened on load)
   // A model to start from instead of random weights (not used on --resume): parameters of
   // the same name and shape are copied; a Linear weight that gained input columns (e.g.
   // the contact cue) keeps the old ones and gets zeros in the new. "" = random start.

@@ -29,6 +29,7 @@ constexpr zip_uint64_t kMaxInflation = 1032;  // deflate's largest expansion rat
 int dtype_size(const std::string& d) {
   if (d == "f8" || d == "i8" || d == "u8") return 8;
   if (d == "f4" || d == "i4" || d == "u4") return 4;
+  if (d == "f2") return 2;  // read as tensors only (npz_tensor.h)
   if (d == "i1" || d == "u1" || d == "b1") return 1;
   // At most 7 digits: std::stol would throw on a longer count (found by fuzzing).
   if (d.size() >= 2 && d.size() <= 8 && d[0] == 'U' && std::all_of(d.begin() + 1, d.end(), ::isdigit)) {
@@ -38,7 +39,7 @@ int dtype_size(const std::string& d) {
   return 0;
 }
 
-const char* kSupported = "f4, f8, i1, i4, i8, u1, u4, u8, b1, U<n>";
+const char* kSupported = "f2, f4, f8, i1, i4, i8, u1, u4, u8, b1, U<n>";
 
 // UTF-8 <-> UCS-4 for the "U<n>" dtype. Invalid UTF-8 bytes become U+FFFD.
 std::vector<uint32_t> utf8_to_ucs4(const std::string& s) {

@@ -1,6 +1,6 @@
 // NumPy .npy arrays and .npz archives (zip files of .npy members), read and written.
 //
-// Supported: little-endian, C-order arrays of f4, f8, i1, i4, i8, u1, u4, u8, b1 and
+// Supported: little-endian, C-order arrays of f4, f8, i1, i4, i8, u1, u4, u8, b1 (f2 as tensors only) and
 // unicode strings (<U n), any rank including 0-d scalars; .npz members stored or deflated.
 // Big-endian, Fortran-order, object and structured arrays are refused with a clear error.
 // The .npy header is parsed by hand (format spec: numpy.lib.format): Debian ships no npy

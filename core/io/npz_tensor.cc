@@ -11,8 +11,8 @@ struct DtypePair {
   at::ScalarType type;
   const char* code;
 };
-constexpr DtypePair kPairs[] = {{at::kFloat, "f4"}, {at::kDouble, "f8"}, {at::kLong, "i8"},
-                                {at::kInt, "i4"},   {at::kByte, "u1"},   {at::kBool, "b1"}};
+constexpr DtypePair kPairs[] = {{at::kFloat, "f4"}, {at::kDouble, "f8"}, {at::kLong, "i8"}, {at::kInt, "i4"},
+                                {at::kByte, "u1"},  {at::kBool, "b1"},   {at::kHalf, "f2"}};
 
 }  // namespace
 

@@ -1,5 +1,5 @@
 // libtorch tensors to and from .npy arrays (core/io/npz.h), keeping the element type:
-// float32 <-> f4, float64 <-> f8, int64 <-> i8, int32 <-> i4, uint8 <-> u1, bool <-> b1.
+// float32 <-> f4, float64 <-> f8, int64 <-> i8, int32 <-> i4, uint8 <-> u1, bool <-> b1, float16 <-> f2.
 #pragma once
 
 #include <string>

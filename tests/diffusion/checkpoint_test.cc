@@ -76,6 +76,25 @@ TEST(Checkpoint, RoundTripKeepsWeightsAndInfo) {
   for (const auto& p : net->named_parameters()) EXPECT_TRUE(at::equal(p.value(), c.weights.at(p.key())));
 }
 
+TEST(Checkpoint, HalfPrecisionWeightsLoadAsTheirFloat32Values) {
+  // An export with export_half stores parameters as float16: about half the file, and on
+  // load the network gets exactly the rounded values, in float32.
+  Checkpoint c = tiny_checkpoint();
+  const std::string full = scratch("full.npz"), half = scratch("half.npz");
+  save_checkpoint(c, full);
+  for (auto& [k, v] : c.weights)
+    if (v.scalar_type() == at::kFloat) v = v.to(at::kHalf);
+  save_checkpoint(c, half);
+  const Checkpoint r = load_checkpoint(half);
+  const Denoiser net = make_denoiser(r, half);
+  for (const auto& p : net->named_parameters()) {
+    EXPECT_EQ(p.value().scalar_type(), at::kFloat);
+    EXPECT_TRUE(at::equal(p.value(), c.weights.at(p.key()).to(at::kFloat))) << p.key();
+  }
+  const double weights_bytes = 4.0 * static_cast<double>(net->num_parameters());
+  EXPECT_NEAR(static_cast<double>(fs::file_size(full) - fs::file_size(half)), weights_bytes / 2, weights_bytes * 0.02);
+}
+
 TEST(Checkpoint, OutputKindRoundTripsAndOlderFilesPredictX0) {
   Checkpoint c = tiny_checkpoint("gaussian");
   ASSERT_EQ(c.weights.count("skip_directions"), 1u);

@@ -201,6 +201,36 @@ TEST(Training, ResumedRunEqualsAnUninterruptedOne) {
   EXPECT_EQ(ca.info.basis_points.sizes(), (std::vector<int64_t>{1024, 3}));
 }
 
+TEST(Training, HalfExportHoldsTheRoundedEmaWeightsAndAFinishedRunRewritesIt) {
+  const fs::path dir = scratch("half");
+  TrainConfig c = tiny_config(dir);
+  c.steps = 3;
+  c.export_path = (dir / "model.npz").string();
+  c.export_half = true;
+  TrainOptions quiet;
+  quiet.progress = false;
+  train(c, quiet);
+  const Checkpoint full = load_checkpoint((dir / "checkpoint.npz").string());
+  const auto check_export = [&]() {
+    const Checkpoint half = load_checkpoint(c.export_path);
+    EXPECT_FALSE(half.train.has_value());
+    const Denoiser net = make_denoiser(half, c.export_path);
+    int n = 0;
+    for (const auto& p : net->named_parameters()) {
+      EXPECT_TRUE(at::equal(p.value(), full.weights.at(p.key()).to(at::kHalf).to(at::kFloat))) << p.key();
+      ++n;
+    }
+    EXPECT_GT(n, 10);
+  };
+  check_export();
+  fs::remove(c.export_path);
+  TrainOptions again = quiet;
+  again.resume = true;
+  EXPECT_EQ(train(c, again).steps_done, 3);  // nothing left to train ...
+  ASSERT_TRUE(fs::exists(c.export_path));     // ... but the missing export is written again
+  check_export();
+}
+
 TEST(Training, ResumeRefusesAnotherNetwork) {
   const fs::path dir = scratch("other_net");
   TrainOptions o;
