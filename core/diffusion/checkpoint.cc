@@ -64,6 +64,11 @@ constexpr IntField kIntFields[] = {
     {"feedforward", &DenoiserConfig::feedforward},
     {"condition_hidden", &DenoiserConfig::condition_hidden},
 };
+// Fields added later: optional on load (older files keep the defaults).
+constexpr IntField kLaterIntFields[] = {
+    {"contact_points", &DenoiserConfig::contact_points},
+    {"point_hidden", &DenoiserConfig::point_hidden},
+};
 
 }  // namespace
 
@@ -79,8 +84,8 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   set_string(f, "network/output", i.network.output);
   f.set("network/skip_rank", make_npy_scalar<std::int64_t>(i.network.skip_rank));
   f.set("network/contact_cue", make_npy_scalar<std::int64_t>(i.network.contact_cue ? 1 : 0));
-  f.set("network/contact_points", make_npy_scalar<std::int64_t>(i.network.contact_points));
-  f.set("network/point_hidden", make_npy_scalar<std::int64_t>(i.network.point_hidden));
+  for (const auto& field : kLaterIntFields)
+    f.set(std::string("network/") + field.key, make_npy_scalar<std::int64_t>(i.network.*field.member));
   set_string(f, "diffusion/schedule", i.schedule);
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
   set_string(f, "encoder/variant", i.variant);
@@ -115,11 +120,13 @@ Checkpoint load_checkpoint(const std::string& path) {
   Checkpoint c;
   ModelInfo& i = c.info;
   i.network.model = get_string(f, "network/model");
-  for (const auto& field : kIntFields) {
-    const std::int64_t v = get_int(f, std::string("network/") + field.key);
-    if (v < 0 || v > (1 << 24)) throw Error(f.where(std::string("network/") + field.key) + ": out of range");
+  const auto read_field = [&](const IntField& field) {
+    const std::string key = std::string("network/") + field.key;
+    const std::int64_t v = get_int(f, key);
+    if (v < 0 || v > (1 << 24)) throw Error(f.where(key) + ": out of range");
     i.network.*field.member = static_cast<int>(v);
-  }
+  };
+  for (const auto& field : kIntFields) read_field(field);
   i.network.dropout = get_double(f, "network/dropout");
   // Checkpoints from before the skip output predicted x0 directly.
   i.network.output = f.contains("network/output") ? get_string(f, "network/output") : "x0";
@@ -130,14 +137,9 @@ Checkpoint load_checkpoint(const std::string& path) {
   }
   // Checkpoints from before the contact cue have none.
   i.network.contact_cue = f.contains("network/contact_cue") && get_int(f, "network/contact_cue") != 0;
-  // ... and from before the contact points none (validate checks the range).
-  for (const auto& [key, member] : {std::pair{"network/contact_points", &DenoiserConfig::contact_points},
-                                    std::pair{"network/point_hidden", &DenoiserConfig::point_hidden}})
-    if (f.contains(key)) {
-      const std::int64_t v = get_int(f, key);
-      if (v < 0 || v > (1 << 24)) throw Error(f.where(key) + ": out of range");
-      i.network.*member = static_cast<int>(v);
-    }
+  // ... and from before the contact points none.
+  for (const auto& field : kLaterIntFields)
+    if (f.contains(std::string("network/") + field.key)) read_field(field);
   try {
     i.network.validate();
   } catch (const Error& e) {

@@ -61,12 +61,12 @@ void DenoiserConfig::validate() const {
   require(output == "x0" || output == "gaussian" || output == "temporal", "output",
           "must be x0, gaussian or temporal, got '" + output + "'");
   require(skip_rank >= 1 && skip_rank <= 65536, "skip_rank", "must be in [1, 65536]");
-  require(!contact_cue || (model == "motion" && contact_condition_size == 2 * 1024 && object_condition_size == 3079),
-          "contact_cue", "needs the motion model with contact maps [2, 1024] and object features [1024, 3 | 7]");
+  const bool has_object_points =
+      model == "motion" && contact_condition_size == 2 * 1024 && object_condition_size == 3079;
+  const char* needs = "needs the motion model with contact maps [2, 1024] and object features [1024, 3 | 7]";
+  require(!contact_cue || has_object_points, "contact_cue", needs);
   require(contact_points >= 0 && contact_points <= 1024, "contact_points", "must be in [0, 1024]");
-  require(contact_points == 0 ||
-              (model == "motion" && contact_condition_size == 2 * 1024 && object_condition_size == 3079),
-          "contact_points", "needs the motion model with contact maps [2, 1024] and object features [1024, 3 | 7]");
+  require(contact_points == 0 || has_object_points, "contact_points", needs);
   require(point_hidden >= 1, "point_hidden", "must be positive");
 }
 
@@ -239,15 +239,10 @@ at::Tensor DenoiserImpl::encode_conditions(const at::Tensor& object, const at::T
     throw Error("denoiser: contact condition must be [" + std::to_string(B) + ", " + std::to_string(T) +
                 ", " + std::to_string(config_.contact_condition_size) + "], got " + c10::str(contact.sizes()));
   }
-  at::Tensor c;
-  if (reads_object_points()) {
-    const ObjectContact in = object_contact_of(object, contact);
-    c = contact_mlp_->forward(config_.contact_cue ? torch::cat({contact, contact_cue(in.points, in.maps)}, -1)
-                                                  : contact);
-    if (contact_points_) c = c + contact_points_->forward(in.points, in.offsets, in.maps);
-  } else {
-    c = contact_mlp_->forward(contact);
-  }
+  const ObjectContact in = reads_object_points() ? object_contact_of(object, contact) : ObjectContact{};
+  at::Tensor c = contact_mlp_->forward(
+      config_.contact_cue ? torch::cat({contact, contact_cue(in.points, in.maps)}, -1) : contact);
+  if (contact_points_) c = c + contact_points_->forward(in.points, in.offsets, in.maps);
   if (!use_contact.defined()) return cond + c;
   const at::Tensor keep = use_contact.to(torch::kBool).view({B, 1, 1});
   return cond + torch::where(keep, c, null);
