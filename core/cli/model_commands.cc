@@ -24,6 +24,7 @@
 #include "core/diffusion/generation.h"
 #include "core/diffusion/sampler.h"
 #include "core/diffusion/schedule.h"
+#include "core/diffusion/temporal_band.h"
 #include "core/diffusion/training.h"
 #include "core/features/contact_cue.h"
 #include "core/util/error.h"
@@ -33,7 +34,7 @@ namespace {
 
 struct CheckArgs {
   std::string checkpoint, dataset, split = "train", sampler = "ddpm", expert;
-  int windows = 16, steps = 0, from = -1, expert_from = 40;
+  int windows = 16, steps = 0, from = -1, expert_from = 40, band = 0;
   long long seed = 1;
   double cfg = 0.5, guidance = 0;
   bool sample = false, no_contact = false;
@@ -106,6 +107,7 @@ int run_check(const CheckArgs& a) {
   g.sampler.steps = a.steps;
   g.cfg_lambda = a.cfg;
   g.use_contact = !a.no_contact;
+  g.band = a.band;
   at::Tensor sm;  // [n, T, D] metres (contact maps flattened)
   if (a.from < 0 && a.expert.empty()) {
     std::vector<at::Tensor> outs;
@@ -141,15 +143,20 @@ int run_check(const CheckArgs& a) {
       const bool high = !expert.is_empty() && t >= a.expert_from;
       diffusion::DenoiserImpl& d = high ? *expert : *net;
       const at::Tensor c = diffusion::predict_x0(d, sched, x, tt, high ? e_cond : cond);
-      return cfg ? diffusion::combine_cfg(c, diffusion::predict_x0(d, sched, x, tt, high ? e_uncond : uncond), a.cfg) : c;
+      return diffusion::band_limit(
+          cfg ? diffusion::combine_cfg(c, diffusion::predict_x0(d, sched, x, tt, high ? e_uncond : uncond), a.cfg) : c,
+          a.band);
     };
     const at::Tensor start =
         a.from < 0 ? at::randn(x0.sizes(), gen)
                    : diffusion::add_noise(sched, x0, at::randn(x0.sizes(), gen), at::full({x0.size(0)}, a.from, at::kLong));
     sm = to_metres(diffusion::sample(sched, predict, start, g.sampler, gen));
   }
-  std::cout << fmt::format("sampled ({} {}{}{}): error {:.2f} mm\n", a.sampler, a.steps == 0 ? sched.steps : a.steps,
-                           motion ? fmt::format(", CFG {}", a.cfg) : "",
+  if (a.band > 0)  // what the band costs the data itself
+    std::cout << fmt::format("ground truth through the band (lowest {} DCT frequencies): error {:.2f} mm\n", a.band,
+                             metric(to_metres(diffusion::band_limit(x0, a.band))));
+  std::cout << fmt::format("sampled ({} {}{}{}{}): error {:.2f} mm\n", a.sampler, a.steps == 0 ? sched.steps : a.steps,
+                           motion ? fmt::format(", CFG {}", a.cfg) : "", a.band > 0 ? fmt::format(", band {}", a.band) : "",
                            a.from < 0 ? "" : fmt::format(", from the truth noised to t = {}", a.from), metric(sm));
   if (motion) {
     // Placement vs shape: the error of each hand's keypoint centroid, and what is left
@@ -201,6 +208,8 @@ void add_model_commands(CLI::App& app, Commands& out) {
   check->add_option("--expert", a->expert, "Experimental: another checkpoint of the same model for the noisiest steps")
       ->check(CLI::ExistingFile);
   check->add_option("--expert-from", a->expert_from, "The expert takes the steps t >= this")->capture_default_str();
+  check->add_option("--band", a->band, "Keep the lowest N DCT frequencies over time of every x0 prediction (0 = off)")
+      ->capture_default_str();
   check->add_option("--guidance", a->guidance,
                     "Motion model, with --sample: contact-map guidance towards the ground-truth maps at this scale (0 = off)")
       ->capture_default_str();

@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include "core/data/normalization.h"
+#include "core/diffusion/temporal_band.h"
 #include "core/util/error.h"
 
 namespace bimart::diffusion {
@@ -175,7 +176,7 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
       x0 = st.normalize_x(metres + at::cat(corr, 0));
     }
     if (cfg) x0 = combine_cfg(x0, out.slice(0, B, 2 * B), o.cfg_lambda);
-    return agree(x0);
+    return agree(band_limit(x0, o.band));
   };
   // One noise per sequence frame, so shared frames start equal; fused again after every step.
   const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));

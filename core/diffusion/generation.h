@@ -28,6 +28,8 @@ struct GenerateOptions {
   int samples = 1;          // batched
   int overlap = 48;         // frames shared by consecutive windows (fused at every step)
   bool use_contact = true;  // motion model: false = null contact token ("w/o C")
+  int band = 0;             // keep the lowest `band` DCT frequencies over each window's frames of
+                            // every x0 prediction (temporal_band.h); 0 = off
 };
 
 class DiffusionModel {
