@@ -138,11 +138,24 @@ int run_check(const CheckArgs& a) {
                                        : expert->encode_conditions(obj);
       if (cfg) e_uncond = expert->encode_conditions(obj);
     }
+    // Guidance towards the ground-truth maps, one per window (each has its own object).
+    std::vector<std::unique_ptr<diffusion::ContactMapGuidance>> guides;
+    if (motion && a.guidance > 0)
+      for (int i = 0; i < n; ++i)
+        guides.push_back(std::make_unique<diffusion::ContactMapGuidance>(
+            object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6)),
+            b.contact_maps[i], a.guidance));
     const auto predict = [&](const at::Tensor& x, int t) {
       const at::Tensor tt = at::full({x.size(0)}, t, at::kLong);
       const bool high = !expert.is_empty() && t >= a.expert_from;
       diffusion::DenoiserImpl& d = high ? *expert : *net;
-      const at::Tensor c = diffusion::predict_x0(d, sched, x, tt, high ? e_cond : cond);
+      at::Tensor c = diffusion::predict_x0(d, sched, x, tt, high ? e_cond : cond);
+      if (!guides.empty()) {
+        const at::Tensor m = st.denormalize_x(c);
+        std::vector<at::Tensor> corr;
+        for (int i = 0; i < n; ++i) corr.push_back(guides[i]->correction(m.slice(0, i, i + 1), 0, t, sched.steps));
+        c = st.normalize_x(m + at::cat(corr, 0));
+      }
       return diffusion::band_limit(
           cfg ? diffusion::combine_cfg(c, diffusion::predict_x0(d, sched, x, tt, high ? e_uncond : uncond), a.cfg) : c,
           a.band);
