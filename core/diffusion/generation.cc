@@ -162,6 +162,9 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   }
   const bool cfg = cond_emb.size(0) == 2 * B;
 
+  // The band's projection over a window's frames, built once (undefined: no band).
+  at::Tensor band;
+  if (o.band > 0 && o.band < lay.length) band = band_projection(lay.length, o.band);
   // Every window takes its part of the fused sequence (nothing to fuse for one window).
   const auto agree = [&](const at::Tensor& x) { return K == 1 ? x : lay.split(lay.fuse(x)); };
   const auto predict = [&](const at::Tensor& x_t, int t) {
@@ -176,7 +179,7 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
       x0 = st.normalize_x(metres + at::cat(corr, 0));
     }
     if (cfg) x0 = combine_cfg(x0, out.slice(0, B, 2 * B), o.cfg_lambda);
-    return agree(band_limit(x0, o.band));
+    return agree(band_limit(x0, band));
   };
   // One noise per sequence frame, so shared frames start equal; fused again after every step.
   const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));

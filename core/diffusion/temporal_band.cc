@@ -22,7 +22,14 @@ at::Tensor band_limit(const at::Tensor& x, std::int64_t keep) {
   if (x.dim() < 2) throw Error("band limit: need [..., frames, D], got " + c10::str(x.sizes()));
   const std::int64_t frames = x.size(-2);
   if (keep <= 0 || keep >= frames) return x;
-  return at::matmul(band_projection(frames, keep).to(x.scalar_type()), x);
+  return band_limit(x, band_projection(frames, keep));
+}
+
+at::Tensor band_limit(const at::Tensor& x, const at::Tensor& projection) {
+  if (!projection.defined()) return x;
+  if (x.dim() < 2 || projection.dim() != 2 || projection.size(0) != x.size(-2) || projection.size(1) != x.size(-2))
+    throw Error("band limit: projection " + c10::str(projection.sizes()) + " does not fit " + c10::str(x.sizes()));
+  return at::matmul(projection.to(x.scalar_type()), x);
 }
 
 }  // namespace bimart::diffusion

@@ -19,4 +19,8 @@ at::Tensor band_projection(std::int64_t frames, std::int64_t keep);
 // frequencies; x itself when keep <= 0 or keep >= frames.
 at::Tensor band_limit(const at::Tensor& x, std::int64_t keep);
 
+// x [..., frames, D] times a projection from band_projection (built once per sampling
+// run, not per step); x itself when the projection is undefined.
+at::Tensor band_limit(const at::Tensor& x, const at::Tensor& projection);
+
 }  // namespace bimart::diffusion

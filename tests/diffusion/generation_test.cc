@@ -9,35 +9,20 @@
 #include <set>
 
 #include "core/diffusion/generation.h"
-#include "core/features/bps.h"
-#include "core/object/families/families.h"
-#include "core/synth/trajectory.h"
 #include "core/util/data_path.h"
+#include "tests/diffusion/laptop_trajectory.h"
 
 namespace bimart::diffusion {
 namespace {
 
-struct Long {
-  at::Tensor O, G;
-  std::int64_t frames = 0;
-};
-
-// A 300-frame "use" trajectory of a procedural laptop, encoded with NP-BPS.
-const Long& long_trajectory() {
-  static const Long l = [] {
-    const ArticulatedObject object = make_object("laptop", 3);
-    TrajectoryOptions to;
-    to.min_frames = to.max_frames = 300;
-    const Trajectory tr = plan_trajectory(object, SequenceKind::Use, 11, to);
-    const BpsBasis basis = load_bps_basis(find_data_file(default_basis_file(BpsVariant::PerPart)));
-    const ObjectEncoding e = encode_object(object, tr.tensor(), basis, BpsVariant::PerPart);
-    return Long{e.features, e.global_states, tr.num_frames()};
-  }();
+// A 300-frame trajectory, encoded once for all tests.
+const EncodedTrajectory& long_trajectory() {
+  static const EncodedTrajectory l = encoded_laptop_use(300);
   return l;
 }
 
 at::Tensor generate_motion(int overlap, std::uint64_t seed) {
-  const Long& l = long_trajectory();
+  const EncodedTrajectory& l = long_trajectory();
   const auto contact = DiffusionModel::load(find_data_file("models/contact.npz"));
   const auto motion = DiffusionModel::load(find_data_file("models/motion.npz"));
   GenerateOptions o;
@@ -113,7 +98,7 @@ TEST(Stitching, A300FrameSequenceHasNoSeamsBetweenWindows) {
 }
 
 TEST(Stitching, SameSeedSameMotion) {
-  const Long& l = long_trajectory();
+  const EncodedTrajectory& l = long_trajectory();
   const auto contact = DiffusionModel::load(find_data_file("models/contact.npz"));
   GenerateOptions o;
   o.overlap = 48;

@@ -10,11 +10,9 @@
 
 #include "core/diffusion/generation.h"
 #include "core/diffusion/temporal_band.h"
-#include "core/features/bps.h"
-#include "core/object/families/families.h"
-#include "core/synth/trajectory.h"
 #include "core/util/data_path.h"
 #include "core/util/error.h"
+#include "tests/diffusion/laptop_trajectory.h"
 
 namespace bimart::diffusion {
 namespace {
@@ -53,21 +51,20 @@ TEST(TemporalBand, KeepsLowFrequenciesAndRemovesHighOnes) {
   EXPECT_TRUE(at::allclose(band_limit(batch, 8)[0], low, 0, 1e-5));
   EXPECT_TRUE(band_limit(batch, 0).is_same(batch));
   EXPECT_TRUE(band_limit(batch, 64).is_same(batch));
+  // A projection built once gives the same, and must fit the frames.
+  EXPECT_TRUE(at::allclose(band_limit(batch, band_projection(64, 8)), band_limit(batch, 8), 0, 1e-6));
+  EXPECT_TRUE(band_limit(batch, at::Tensor()).is_same(batch));
+  EXPECT_THROW(band_limit(batch, band_projection(32, 8)), Error);
 }
 
 TEST(TemporalBand, SampledWindowsLieInTheBand) {
-  const ArticulatedObject object = make_object("laptop", 3);
-  TrajectoryOptions to;
-  to.min_frames = to.max_frames = 64;
-  const Trajectory tr = plan_trajectory(object, SequenceKind::Use, 11, to);
-  const BpsBasis basis = load_bps_basis(find_data_file(default_basis_file(BpsVariant::PerPart)));
-  const ObjectEncoding e = encode_object(object, tr.tensor(), basis, BpsVariant::PerPart);
+  const EncodedTrajectory e = encoded_laptop_use(64);
   const auto contact = DiffusionModel::load(find_data_file("models/contact.npz"));
   GenerateOptions o;
   o.sampler.sampler = "ddim";
   o.sampler.steps = 5;
   o.band = 8;
-  const at::Tensor C = contact->generate(e.features, e.global_states, {}, nullptr, o, at::detail::createCPUGenerator(3));
+  const at::Tensor C = contact->generate(e.O, e.G, {}, nullptr, o, at::detail::createCPUGenerator(3));
   ASSERT_EQ(C.sizes(), (std::vector<int64_t>{1, 64, 2, 1024}));
   // In the band up to the clamp at 0 m of the denormalised maps: project the unclamped
   // part only.
@@ -77,7 +74,7 @@ TEST(TemporalBand, SampledWindowsLieInTheBand) {
   ASSERT_GT(kept.size(1), 100);
   EXPECT_LT((band_limit(kept, 8) - kept).abs().max().item<double>(), 1e-4);
   o.band = 0;
-  const at::Tensor free = contact->generate(e.features, e.global_states, {}, nullptr, o, at::detail::createCPUGenerator(3));
+  const at::Tensor free = contact->generate(e.O, e.G, {}, nullptr, o, at::detail::createCPUGenerator(3));
   const at::Tensor f = free[0].flatten(1).to(at::kDouble).index({at::indexing::Slice(), positive});
   EXPECT_GT((band_limit(f, 8) - f).abs().max().item<double>(), 1e-3);  // without it, it is not
 }
