@@ -37,6 +37,7 @@ struct CheckArgs {
   int windows = 16, steps = 0, from = -1, expert_from = 40, band = 0;
   long long seed = 1;
   double cfg = 0.5, guidance = 0;
+  int place = 0;
   bool sample = false, no_contact = false;
 };
 
@@ -114,10 +115,11 @@ int run_check(const CheckArgs& a) {
     for (int i = 0; i < n; ++i) {
       const at::Tensor C = motion && !a.no_contact ? b.contact_maps[i] : at::Tensor();
       std::unique_ptr<diffusion::ContactMapGuidance> guidance;
-      if (motion && a.guidance > 0) {  // towards the ground-truth maps
+      if (motion && (a.guidance > 0 || a.place > 0)) {  // towards the ground-truth maps
         const at::Tensor points = object_points_from_bps(b.object_features[i], data.basis_points(),
                                                          b.global_states[i].select(1, 6));
         guidance = std::make_unique<diffusion::ContactMapGuidance>(points, b.contact_maps[i], a.guidance);
+        guidance->set_placement(a.place);
       }
       outs.push_back(model->generate(b.object_features[i], b.global_states[i], C, guidance.get(), g, gen)[0]);
     }
@@ -225,6 +227,10 @@ void add_model_commands(CLI::App& app, Commands& out) {
       ->capture_default_str();
   check->add_option("--guidance", a->guidance,
                     "Motion model, with --sample: contact-map guidance towards the ground-truth maps at this scale (0 = off)")
+      ->capture_default_str();
+  check->add_option("--place", a->place,
+                    "Motion model, with --sample: translate each hand onto the ground-truth contacts at the last N steps "
+                    "(contact placement; 0 = off)")
       ->capture_default_str();
   check->add_flag("--no-contact", a->no_contact, "Motion model: the null contact token instead of the maps");
   out.push_back({check, [a] { return run_check(*a); }, false});

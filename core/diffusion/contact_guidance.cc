@@ -26,6 +26,13 @@ ContactMapGuidance::ContactMapGuidance(at::Tensor object_points, at::Tensor targ
   if (!(scale >= 0)) throw Error("contact-map guidance: scale must not be negative");
 }
 
+void ContactMapGuidance::set_placement(int steps, const PlacementOptions& options) {
+  if (steps < 0) throw Error("contact-map guidance: placement steps must be >= 0");
+  options.validate();
+  place_steps_ = steps;
+  placement_ = options;
+}
+
 namespace {
 
 // The nearest of J keypoints (kx, ky, kz) for each of M points (px, py, pz): squared
@@ -120,7 +127,7 @@ at::Tensor ContactMapGuidance::discrepancy(const at::Tensor& x0, std::int64_t fi
   return (dist - targets(first, T, B)).pow(2).mean({1, 2, 3});
 }
 
-at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t first, int /*step*/,
+at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t first, int step,
                                           int /*num_steps*/) const {
   const auto B = x0.size(0), T = x0.size(1);
   if (x0.dim() != 3 || x0.size(2) != kHandFeatureSize)
@@ -128,28 +135,37 @@ at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t fir
   if (first < 0 || first + T > points_.size(0))
     throw Error("contact-map guidance: frames [" + std::to_string(first) + ", " + std::to_string(first + T) +
                 ") outside the " + std::to_string(points_.size(0)) + " frames it was made for");
-  at::Tensor out = at::zeros_like(x0);
-  if (scale_ == 0.0) return out;
+  at::Tensor out = at::zeros_like(x0, at::kFloat);
+  const bool place = step < place_steps_;
+  if (scale_ == 0.0 && !place) return out.to(x0.scalar_type());
   const at::Tensor H = keypoint_blocks(x0.slice(-1, 0, 600).reshape({B, T, 2, kHandKeypoints, 3}));
   const at::Tensor P = points_.slice(0, first, first + T).contiguous();  // [T, 1024, 3]
   const at::Tensor C = targets(first, T, B).contiguous();                 // [B, T, 2, 1024]
-  // d/dh of mean((|p - h*| - c)²) = 2 (d - c) / n · (h* - p) / d, summed onto h*; each
-  // block owns its keypoints' gradient, so the parallel blocks never write the same entry.
-  const double n = static_cast<double>(T) * 2 * 1024;
-  at::Tensor grad = at::zeros_like(H);
-  float* g = grad.data_ptr<float>();
-  const float* h = H.data_ptr<float>();
-  const float* c = C.data_ptr<float>();
-  const float* p = P.data_ptr<float>();
-  for_each_nearest(H, P, [&](std::int64_t blk, std::int64_t m, std::int64_t best, float dm) {
-    const float coef = static_cast<float>(2.0 / n) * (dm - c[blk * 1024 + m]) / std::max(dm, 1e-6f);
-    const float* k = h + (blk * kHandKeypoints + best) * 3;
-    const float* pt = p + (((blk / 2) % T) * 1024 + m) * 3;
-    float* gk = g + (blk * kHandKeypoints + best) * 3;
-    for (int a = 0; a < 3; ++a) gk[a] += coef * (k[a] - pt[a]);
-  });
-  const at::Tensor norm = grad.reshape({B, -1}).norm(2, 1).clamp_min(1e-12).view({B, 1, 1, 1, 1});
-  const at::Tensor step_h = (-scale_ * grad / norm).reshape({B, T, 600});
+  at::Tensor step_h = at::zeros({B, T, 600}, at::kFloat);
+  if (scale_ != 0.0) {
+    // d/dh of mean((|p - h*| - c)²) = 2 (d - c) / n · (h* - p) / d, summed onto h*; each
+    // block owns its keypoints' gradient, so the parallel blocks never write the same entry.
+    const double n = static_cast<double>(T) * 2 * 1024;
+    at::Tensor grad = at::zeros_like(H);
+    float* g = grad.data_ptr<float>();
+    const float* h = H.data_ptr<float>();
+    const float* c = C.data_ptr<float>();
+    const float* p = P.data_ptr<float>();
+    for_each_nearest(H, P, [&](std::int64_t blk, std::int64_t m, std::int64_t best, float dm) {
+      const float coef = static_cast<float>(2.0 / n) * (dm - c[blk * 1024 + m]) / std::max(dm, 1e-6f);
+      const float* k = h + (blk * kHandKeypoints + best) * 3;
+      const float* pt = p + (((blk / 2) % T) * 1024 + m) * 3;
+      float* gk = g + (blk * kHandKeypoints + best) * 3;
+      for (int a = 0; a < 3; ++a) gk[a] += coef * (k[a] - pt[a]);
+    });
+    const at::Tensor norm = grad.reshape({B, -1}).norm(2, 1).clamp_min(1e-12).view({B, 1, 1, 1, 1});
+    step_h = (-scale_ * grad / norm).reshape({B, T, 600});
+  }
+  if (place) {
+    const at::Tensor moved = H + step_h.view({B, T, 2, kHandKeypoints, 3});
+    const at::Tensor delta = contact_translations(moved, P, C, placement_);  // [B, T, 2, 3]
+    step_h = step_h + delta.unsqueeze(3).expand({B, T, 2, kHandKeypoints, 3}).reshape({B, T, 600});
+  }
   out.slice(-1, 0, 600).copy_(step_h);
   out.slice(-1, 600, 1200).copy_(-step_h);
   return out.to(x0.scalar_type());

@@ -14,6 +14,7 @@
 
 #include <ATen/core/Tensor.h>
 
+#include "core/diffusion/contact_placement.h"
 #include "stages/guidance.h"
 
 namespace bimart::diffusion {
@@ -24,6 +25,10 @@ class ContactMapGuidance : public Guidance {
   // contact maps [N, 2, 1024] or [S, N, 2, 1024] (m). scale: norm of the correction per
   // sample; 0 turns guidance off.
   ContactMapGuidance(at::Tensor object_points, at::Tensor target, double scale = 1.0);
+
+  // Also translate each hand onto its contacts (core/diffusion/contact_placement.h) at the
+  // last `steps` diffusion steps (0 = never, the paper's method), after the gradient step.
+  void set_placement(int steps, const PlacementOptions& options = {});
 
   at::Tensor correction(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
 
@@ -40,6 +45,8 @@ class ContactMapGuidance : public Guidance {
   at::Tensor points_;  // [N, 1024, 3] float32
   at::Tensor target_;  // [S, N, 2, 1024] float32
   double scale_;
+  int place_steps_ = 0;
+  PlacementOptions placement_;
 };
 
 }  // namespace bimart::diffusion

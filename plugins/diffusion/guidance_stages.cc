@@ -12,25 +12,40 @@ namespace {
 class ContactMapGuidanceStage : public GuidanceStage {
  public:
   static StageSpec spec() {
+    const diffusion::PlacementOptions d;
     return StageSpec::of<GuidanceStage>("contact_map",
                                         "pulls the keypoints' contact map onto C at every diffusion step")
         .param("scale", 1.0, "norm of the correction per sample (λ_c = scale / ||∇||); 0 = off")
+        .param("place_steps", 0,
+               "also translate each hand onto its contacts at the last this many steps (ours; 0 = the paper's)")
+        .param("place_threshold", d.threshold, "m: object points with C below this are contacts (placement)")
+        .param("place_sigma", d.sigma, "frames: smoothing of the placement's translations over time")
+        .param("place_iterations", d.iterations, "ICP rounds of the placement")
         .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
   }
-  explicit ContactMapGuidanceStage(const Params& p) : scale_(p.number("scale")) {
+  explicit ContactMapGuidanceStage(const Params& p)
+      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))) {
     if (!(scale_ >= 0)) throw Error("'scale' must not be negative");
+    if (place_steps_ < 0) throw Error("'place_steps' must not be negative");
+    place_.threshold = p.number("place_threshold");
+    place_.sigma = p.number("place_sigma");
+    place_.iterations = static_cast<int>(p.integer("place_iterations"));
+    place_.validate();
   }
   void run(StageIO& io) override {
     const at::Tensor points = basis_hit_points(io.in<ArticulatedObject>("object"), io.in<at::Tensor>("object_states"),
                                                io.in<at::Tensor>("basis_hit_indices"));
     const at::Tensor target = io.has("contact_maps_samples") ? io.in<at::Tensor>("contact_maps_samples")
                                                              : io.in<at::Tensor>("contact_maps");
-    io.out("guidance", std::shared_ptr<const Guidance>(
-                           std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_)));
+    auto g = std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_);
+    g->set_placement(place_steps_, place_);
+    io.out("guidance", std::shared_ptr<const Guidance>(std::move(g)));
   }
 
  private:
   double scale_;
+  int place_steps_;
+  diffusion::PlacementOptions place_;
 };
 
 class NoGuidance : public Guidance {
