@@ -198,6 +198,17 @@ int run_check(const CheckArgs& a) {
     const auto change = [](const at::Tensor& c) { return (c.slice(1, 1) - c.slice(1, 0, -1)).abs().mean().item<double>(); };
     std::cout << fmt::format("  frame-to-frame change |C_t - C_t-1|: sample {:.3f} mm, ground truth {:.3f} mm\n",
                              1000.0 * change(sm), 1000.0 * change(truth));
+    // Whether the maps put a hand on the object at all: a hand-frame touches when its map's
+    // minimum is below 1 cm (what placement and the Con metric hinge on).
+    const auto minima = [](const at::Tensor& c) { return std::get<0>(c.reshape({c.size(0), c.size(1), 2, -1}).min(-1)); };
+    const at::Tensor ms = minima(sm), mt = minima(truth), touching = mt < 0.01;
+    const double k = touching.sum().item<double>();
+    std::cout << fmt::format("  hand-frames touching (min C < 1 cm): sample {:.1f} %, ground truth {:.1f} %; where the truth "
+                             "touches, the sample's min C is {:.1f} mm (truth {:.1f})\n",
+                             100.0 * (ms < 0.01).to(at::kDouble).mean().item<double>(),
+                             100.0 * touching.to(at::kDouble).mean().item<double>(),
+                             k > 0 ? 1000.0 * (ms * touching).sum().item<double>() / k : NAN,
+                             k > 0 ? 1000.0 * (mt * touching).sum().item<double>() / k : NAN);
   }
   return 0;
 }

@@ -141,17 +141,21 @@ at::Tensor NormalizationStats::normalize_object(const at::Tensor& object_feature
 at::Tensor NormalizationStats::normalize_c(const at::Tensor& c) const {
   if (!c.defined() || c.dim() < 2 || c.size(-2) != 2 || c.size(-1) != kBasisRows)
     throw Error("normalize_c: contact maps must be [..., 2, 1024], got " + shape_str(c));
-  return normalize(c.flatten(-2), c_mean, c_std).view(c.sizes());
+  const at::Tensor v = c_log_eps > 0 ? at::log(c.clamp_min(0) + c_log_eps) : c;
+  return normalize(v.flatten(-2), c_mean, c_std).view(c.sizes());
 }
 
 at::Tensor NormalizationStats::denormalize_c(const at::Tensor& c) const {
   if (!c.defined() || c.dim() < 2 || c.size(-2) != 2 || c.size(-1) != kBasisRows)
     throw Error("denormalize_c: contact maps must be [..., 2, 1024], got " + shape_str(c));
-  return denormalize(c.flatten(-2), c_mean, c_std).view(c.sizes());
+  const at::Tensor v = denormalize(c.flatten(-2), c_mean, c_std).view(c.sizes());
+  return c_log_eps > 0 ? at::exp(v) - c_log_eps : v;
 }
 
-NormalizationStats compute_normalization(const WindowDataset& train, double std_floor) {
+NormalizationStats compute_normalization(const WindowDataset& train, double std_floor, double c_log_eps) {
   if (train.size() == 0) throw Error("normalisation statistics need at least one window");
+  if (!(c_log_eps >= 0) || !std::isfinite(c_log_eps))
+    throw Error("normalisation: the contact maps' log epsilon must be >= 0, got " + std::to_string(c_log_eps));
   if (!(std_floor > 0) || !std::isfinite(std_floor))
     throw Error("normalisation: the std floor must be positive, got " + std::to_string(std_floor));
   at::NoGradGuard no_grad;
@@ -190,7 +194,9 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
       }
       Partial p;
       p.x = moments_of(s.hand_features, frames, kHandFeatureSize, weight.data());
-      p.c = moments_of(s.contact_maps, frames, 2 * kBasisRows, weight.data());
+      p.c = c_log_eps > 0 ? moments_of(at::log(s.contact_maps.to(at::kFloat).clamp_min(0) + c_log_eps).contiguous(),
+                                       frames, 2 * kBasisRows, weight.data())
+                          : moments_of(s.contact_maps, frames, 2 * kBasisRows, weight.data());
       const int64_t rows = s.object_features.size(0);
       std::vector<double> row_weight(static_cast<std::size_t>(rows), 0.0);  // frames sharing an O row
       const int32_t* row_of = s.feature_row.data_ptr<int32_t>();
@@ -212,6 +218,7 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
   st.variant = bps_variant_name(train.variant());
   st.count = static_cast<std::int64_t>(std::llround(all.x.weight));
   st.std_floor = std_floor;
+  st.c_log_eps = c_log_eps;
   st.x_mean = mean_of(all.x);
   st.x_std = floored_std(all.x, std_floor);
   st.c_mean = mean_of(all.c);
@@ -233,6 +240,7 @@ void store_normalization(const NormalizationStats& stats, NpzFile& f, const std:
   f.set(prefix + "variant", make_npy_strings({stats.variant}, {}));
   f.set(prefix + "count", make_npy_scalar<std::int64_t>(stats.count));
   f.set(prefix + "std_floor", make_npy_scalar<double>(stats.std_floor));
+  if (stats.c_log_eps > 0) f.set(prefix + "c_log_eps", make_npy_scalar<double>(stats.c_log_eps));
   f.set(prefix + "x_mean", npy_of(stats.x_mean));
   f.set(prefix + "x_std", npy_of(stats.x_std));
   f.set(prefix + "obj_mean", npy_of(stats.obj_mean));
@@ -257,6 +265,9 @@ NormalizationStats read_normalization(const NpzFile& f, const std::string& prefi
   if (count.size() != 1 || count[0] < 1) throw Error(f.where(prefix + "count") + " must be one positive number");
   st.count = count[0];
   if (f.contains(prefix + "std_floor")) st.std_floor = f.vector<double>(prefix + "std_floor").at(0);
+  if (f.contains(prefix + "c_log_eps")) st.c_log_eps = f.vector<double>(prefix + "c_log_eps").at(0);
+  if (!(st.c_log_eps >= 0) || !std::isfinite(st.c_log_eps))
+    throw Error(f.where(prefix + "c_log_eps") + " must be a number >= 0");
   st.x_mean = read_vector(f, prefix + "x_mean", kHandFeatureSize, false);
   st.x_std = read_vector(f, prefix + "x_std", kHandFeatureSize, true);
   st.obj_mean = read_vector(f, prefix + "obj_mean", kObjectConditionSize, false);

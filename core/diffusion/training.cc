@@ -212,7 +212,7 @@ TrainConfig load_train_config(const std::string& path) {
   if (const YAML::Node n = root["network"]) {
     check_keys(path, n, "network",
                {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank",
-                "contact_cue", "contact_points", "point_hidden"});
+                "contact_cue", "contact_points", "point_hidden", "contact_log_eps"});
     read(path, n, "latent", c.network.latent);
     read(path, n, "layers", c.network.layers);
     read(path, n, "heads", c.network.heads);
@@ -224,6 +224,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "contact_cue", c.network.contact_cue);
     read(path, n, "contact_points", c.network.contact_points);
     read(path, n, "point_hidden", c.network.point_hidden);
+    read(path, n, "contact_log_eps", c.contact_log_eps);
   }
   if (const YAML::Node n = root["diffusion"]) {
     check_keys(path, n, "diffusion", {"schedule", "steps"});
@@ -268,6 +269,8 @@ void validate(const TrainConfig& c) {
   need(!c.out.empty(), "'out' (the run folder) is required");
   parse_bps_variant(c.variant);
   need(c.stride >= 1, "'stride' must be positive");
+  need(c.contact_log_eps >= 0 && std::isfinite(c.contact_log_eps), "'network.contact_log_eps' must be >= 0 (metres)");
+  need(c.contact_log_eps == 0 || c.model == "contact", "'network.contact_log_eps' is for the contact model only");
   c.network.validate();
   make_schedule(c.schedule, c.diffusion_steps);
   need(c.batch >= 1 && c.batch <= 100000, "'training.batch' must be in [1, 100000]");
@@ -442,7 +445,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     test_set = std::make_unique<WindowDataset>(WindowDataset::open(config.data, "test", wo));
   bar.reset();
   if (train_set.size() == 0) throw Error(config.data + ": the train split has no windows");
-  const NormalizationStats stats = compute_normalization(train_set);
+  const NormalizationStats stats = compute_normalization(train_set, kNormalizationStdFloor, config.contact_log_eps);
   const NoiseSchedule schedule = make_schedule(config.schedule, config.diffusion_steps);
 
   ModelInfo info;

@@ -41,6 +41,9 @@ struct TrainConfig {
   std::string variant = "np_bps";
   int stride = 16;         // window stride of the training windows
   DenoiserConfig network;
+  // Contact model: > 0 samples C in log space, log(C + contact_log_eps) normalised (metres;
+  // NormalizationStats::c_log_eps). 0: C itself (the paper's).
+  double contact_log_eps = 0;
   std::string schedule = "squaredcos_cap_v2";
   int diffusion_steps = 50;
   int batch = 64;          // windows per step (per process when distributed)

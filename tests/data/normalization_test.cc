@@ -91,6 +91,36 @@ TEST(Normalization, TrainDataIsStandardisedPerFeature) {
   EXPECT_EQ(st.normalize_x(x.to(at::kDouble)).scalar_type(), at::kDouble);
 }
 
+TEST(Normalization, ContactMapsInLogSpace) {
+  const WindowDataset& ds = tiny_train();
+  const double eps = 0.005;
+  const NormalizationStats st = compute_normalization(ds, kNormalizationStdFloor, eps);
+  EXPECT_DOUBLE_EQ(st.c_log_eps, eps);
+  EXPECT_TRUE(at::equal(st.x_mean, train_stats().x_mean));  // only C changes
+  const WindowBatch b = ds.batch(all_windows(ds));
+  const at::Tensor valid = b.mask.flatten().nonzero().squeeze(1);
+  const int64_t m = b.mask.numel();
+  // The statistics are those of log(C + eps); normalised C has mean 0 in that space.
+  const at::Tensor logc = at::log(b.contact_maps.view({m, 2048}).to(at::kDouble) + eps).index_select(0, valid);
+  const auto [log_mean, log_std] = moments(logc);
+  EXPECT_LT((log_mean - st.c_mean).abs().max().item<double>(), 1e-5);
+  EXPECT_TRUE(at::allclose(log_std.clamp_min(st.std_floor), st.c_std, 1e-4, 1e-8));
+  EXPECT_LT(st.normalize_c(b.contact_maps).view({m, 2048}).index_select(0, valid).to(at::kDouble).mean(0).abs().max()
+                .item<double>(),
+            1e-4);
+  // Round trip, and a 1 mm change at contact moves z far more than the same change at 20 cm.
+  EXPECT_LT((st.denormalize_c(st.normalize_c(b.contact_maps)) - b.contact_maps).abs().max().item<float>(), 1e-5);
+  at::Tensor c = at::full({1, 2, 1024}, 0.002);
+  c[0][1].fill_(0.2);
+  const at::Tensor dz = (st.normalize_c(c + 0.001) - st.normalize_c(c)) * st.c_std.view({2, 1024}).to(at::kFloat);
+  EXPECT_GT(dz[0][0].mean().item<double>(), 20 * dz[0][1].mean().item<double>());  // log(8/7) / log(206/205) ≈ 27
+  // Stored with the statistics, absent (0) for plain ones; negative is refused.
+  const fs::path dir = tiny_dataset().dir / "stats_log";
+  save_normalization(st, (dir / "stats.npz").string());
+  EXPECT_DOUBLE_EQ(load_normalization((dir / "stats.npz").string()).c_log_eps, eps);
+  EXPECT_THROW(compute_normalization(ds, kNormalizationStdFloor, -1), Error);
+}
+
 TEST(Normalization, StatisticsComeFromTheTrainSplitOnly) {
   WindowDatasetOptions o;
   o.cache = false;
@@ -108,6 +138,7 @@ TEST(Normalization, SaveLoadAndErrors) {
   EXPECT_EQ(back.variant, "np_bps");
   EXPECT_EQ(back.count, train_stats().count);
   EXPECT_DOUBLE_EQ(back.std_floor, 1e-3);
+  EXPECT_EQ(back.c_log_eps, 0.0);
   for (auto [a, b] : {std::pair{&back.x_mean, &train_stats().x_mean},
                       {&back.x_std, &train_stats().x_std},
                       {&back.obj_mean, &train_stats().obj_mean},
