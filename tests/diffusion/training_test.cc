@@ -96,6 +96,13 @@ TEST(Training, ConfigFileErrorsNameTheLine) {
   }
   std::ofstream(bad) << "model: motion\ndata: d\nout: o\nnetwork:\n  heads: 7\n";
   EXPECT_THROW(load_train_config(bad.string()), Error);  // 7 does not divide 512
+  // Contact maps in log space: the contact model's, read from the network section.
+  std::ofstream(good) << "model: contact\ndata: d\nout: o\nnetwork:\n  contact_log_eps: 0.005\n";
+  EXPECT_DOUBLE_EQ(load_train_config(good.string()).contact_log_eps, 0.005);
+  std::ofstream(bad) << "model: motion\ndata: d\nout: o\nnetwork:\n  contact_log_eps: 0.005\n";
+  EXPECT_THROW(load_train_config(bad.string()), Error);
+  std::ofstream(bad) << "model: contact\ndata: d\nout: o\nnetwork:\n  contact_log_eps: -1\n";
+  EXPECT_THROW(load_train_config(bad.string()), Error);
 }
 
 TEST(Training, WarmStartFromAModelWithoutTheContactCueKeepsItsOutput) {
