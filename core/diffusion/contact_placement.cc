@@ -15,6 +15,7 @@ void PlacementOptions::validate() const {
   if (iterations < 1) throw Error("contact placement: iterations must be >= 1");
   if (min_points < 1) throw Error("contact placement: min_points must be >= 1");
   if (!(sigma >= 0) || !std::isfinite(sigma)) throw Error("contact placement: sigma must be >= 0 (frames)");
+  if (!(snap >= 0) || !std::isfinite(snap)) throw Error("contact placement: snap must be >= 0 (metres)");
 }
 
 namespace {
@@ -39,7 +40,7 @@ at::Tensor contact_translations(const at::Tensor& keypoints, const at::Tensor& o
   o.validate();
   const at::Tensor H0 = keypoints.to(at::kFloat);
   const at::Tensor P = object_points.to(at::kFloat);
-  const at::Tensor C = contact_maps.to(at::kFloat);
+  at::Tensor C = contact_maps.to(at::kFloat);
   if (H0.dim() != 5 || H0.size(2) != 2 || H0.size(4) != 3 || P.dim() != 3 || P.size(0) != H0.size(1) ||
       P.size(2) != 3 || C.dim() != 4 || C.size(0) != H0.size(0) || C.size(1) != H0.size(1) || C.size(2) != 2 ||
       C.size(3) != P.size(1))
@@ -47,6 +48,10 @@ at::Tensor contact_translations(const at::Tensor& keypoints, const at::Tensor& o
                 "[B, T, 2, M], got " + c10::str(H0.sizes()) + ", " + c10::str(P.sizes()) + " and " +
                 c10::str(C.sizes()));
   const std::int64_t B = H0.size(0), T = H0.size(1), M = P.size(1);
+  if (o.snap > o.threshold) {  // nearly touching hands: the map shifted down by its minimum
+    const at::Tensor m = std::get<0>(C.min(-1, true));
+    C = C - m * ((m >= o.threshold) & (m < o.snap)).to(at::kFloat);
+  }
   const at::Tensor contact = (C < o.threshold).to(at::kFloat);                         // [B, T, 2, M]
   const at::Tensor count = contact.sum(-1);                                           // [B, T, 2]
   const at::Tensor w = (count >= static_cast<double>(o.min_points)).to(at::kFloat);  // frames with contacts

@@ -19,6 +19,10 @@ struct PlacementOptions {
   int iterations = 8;       // ICP rounds (nearest keypoints re-found each round)
   int min_points = 4;       // fewer contacts than this in a frame: no translation there
   double sigma = 2.0;       // frames: the smoothing's standard deviation; 0 = none
+  // A hand whose map's minimum m lies in [threshold, snap) is taken to touch where its map
+  // is smallest: its map is read as C − m. (A sampled map is often a blurred one, its
+  // minimum a few cm where the data's is 0.) snap <= threshold: off.
+  double snap = 0;
   void validate() const;    // throws bimart::Error naming the option
 };
 

@@ -21,6 +21,9 @@ class ContactMapGuidanceStage : public GuidanceStage {
         .param("place_threshold", d.threshold, "m: object points with C below this are contacts (placement)")
         .param("place_sigma", d.sigma, "frames: smoothing of the placement's translations over time")
         .param("place_iterations", d.iterations, "ICP rounds of the placement")
+        .param("place_snap", d.snap,
+               "m: a hand whose map's minimum is below this (not touching per place_threshold) is placed where its "
+               "map is smallest (0 = off)")
         .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
   }
   explicit ContactMapGuidanceStage(const Params& p)
@@ -30,6 +33,7 @@ class ContactMapGuidanceStage : public GuidanceStage {
     place_.threshold = p.number("place_threshold");
     place_.sigma = p.number("place_sigma");
     place_.iterations = static_cast<int>(p.integer("place_iterations"));
+    place_.snap = p.number("place_snap");
     place_.validate();
   }
   void run(StageIO& io) override {

@@ -82,6 +82,24 @@ TEST(ContactPlacement, FramesWithoutContactsStayAndTheTranslationFadesIntoThem) 
   EXPECT_GT(size[21].item<double>(), 1e-3);
 }
 
+TEST(ContactPlacement, SnapPlacesANearlyTouchingHandWhereItsMapIsSmallest) {
+  const int T = 3;
+  const at::Tensor P = sphere_points().unsqueeze(0).expand({T, 1024, 3}).contiguous();
+  const at::Tensor truth = wrapping_hand().view({1, 1, 1, 100, 3}).expand({1, T, 2, 100, 3}).contiguous();
+  // A blurred map: every distance 2 cm too large, so no point is below the 1 cm threshold.
+  const at::Tensor C = ContactMapGuidance::keypoint_contact_map(truth, P).first + 0.02;
+  at::Tensor offset = at::zeros({1, T, 2, 1, 3});
+  offset.select(-1, 0).fill_(0.03);
+  PlacementOptions o;
+  o.iterations = 30;
+  EXPECT_EQ(contact_translations(truth + offset, P, C, o).abs().max().item<double>(), 0.0);  // no contacts
+  o.snap = 0.03;
+  const at::Tensor delta = contact_translations(truth + offset, P, C, o);
+  EXPECT_LT((delta + offset.squeeze(3)).norm(2, -1).max().item<double>(), 0.004);
+  o.snap = 0.015;  // the minimum (~2 cm) is beyond the snap distance
+  EXPECT_EQ(contact_translations(truth + offset, P, C, o).abs().max().item<double>(), 0.0);
+}
+
 TEST(ContactPlacement, GuidancePlacesOnlyAtItsLastSteps) {
   const int T = 4;
   const at::Tensor P = sphere_points().unsqueeze(0).expand({T, 1024, 3}).contiguous();
