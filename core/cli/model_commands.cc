@@ -109,18 +109,21 @@ int run_check(const CheckArgs& a) {
   g.cfg_lambda = a.cfg;
   g.use_contact = !a.no_contact;
   g.band = a.band;
+  // Guidance (and placement) towards window i's ground-truth maps; null when off.
+  const auto guidance_for = [&](int i) -> std::unique_ptr<diffusion::ContactMapGuidance> {
+    if (!motion || (a.guidance <= 0 && a.place <= 0)) return nullptr;
+    auto g = std::make_unique<diffusion::ContactMapGuidance>(
+        object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6)),
+        b.contact_maps[i], a.guidance);
+    g->set_placement(a.place);
+    return g;
+  };
   at::Tensor sm;  // [n, T, D] metres (contact maps flattened)
   if (a.from < 0 && a.expert.empty()) {
     std::vector<at::Tensor> outs;
     for (int i = 0; i < n; ++i) {
       const at::Tensor C = motion && !a.no_contact ? b.contact_maps[i] : at::Tensor();
-      std::unique_ptr<diffusion::ContactMapGuidance> guidance;
-      if (motion && (a.guidance > 0 || a.place > 0)) {  // towards the ground-truth maps
-        const at::Tensor points = object_points_from_bps(b.object_features[i], data.basis_points(),
-                                                         b.global_states[i].select(1, 6));
-        guidance = std::make_unique<diffusion::ContactMapGuidance>(points, b.contact_maps[i], a.guidance);
-        guidance->set_placement(a.place);
-      }
+      const auto guidance = guidance_for(i);
       outs.push_back(model->generate(b.object_features[i], b.global_states[i], C, guidance.get(), g, gen)[0]);
     }
     sm = motion ? at::stack(outs, 0) : at::stack(outs, 0).flatten(-2);
@@ -142,11 +145,10 @@ int run_check(const CheckArgs& a) {
     }
     // Guidance towards the ground-truth maps, one per window (each has its own object).
     std::vector<std::unique_ptr<diffusion::ContactMapGuidance>> guides;
-    if (motion && a.guidance > 0)
-      for (int i = 0; i < n; ++i)
-        guides.push_back(std::make_unique<diffusion::ContactMapGuidance>(
-            object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6)),
-            b.contact_maps[i], a.guidance));
+    for (int i = 0; i < n; ++i)
+      if (auto g = guidance_for(i)) guides.push_back(std::move(g));
+    const std::int64_t frames = x0.size(1);
+    const at::Tensor band = a.band > 0 && a.band < frames ? diffusion::band_projection(frames, a.band) : at::Tensor();
     const auto predict = [&](const at::Tensor& x, int t) {
       const at::Tensor tt = at::full({x.size(0)}, t, at::kLong);
       const bool high = !expert.is_empty() && t >= a.expert_from;
@@ -160,7 +162,7 @@ int run_check(const CheckArgs& a) {
       }
       return diffusion::band_limit(
           cfg ? diffusion::combine_cfg(c, diffusion::predict_x0(d, sched, x, tt, high ? e_uncond : uncond), a.cfg) : c,
-          a.band);
+          band);
     };
     const at::Tensor start =
         a.from < 0 ? at::randn(x0.sizes(), gen)

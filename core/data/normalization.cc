@@ -138,11 +138,15 @@ at::Tensor NormalizationStats::normalize_object(const at::Tensor& object_feature
   return normalize(object_condition(object_features, global_states), obj_mean, obj_std);
 }
 
+namespace {
+// C as the statistics see it: log(C + eps) when eps > 0, else C.
+at::Tensor contact_space(const at::Tensor& c, double eps) { return eps > 0 ? at::log(c.clamp_min(0) + eps) : c; }
+}  // namespace
+
 at::Tensor NormalizationStats::normalize_c(const at::Tensor& c) const {
   if (!c.defined() || c.dim() < 2 || c.size(-2) != 2 || c.size(-1) != kBasisRows)
     throw Error("normalize_c: contact maps must be [..., 2, 1024], got " + shape_str(c));
-  const at::Tensor v = c_log_eps > 0 ? at::log(c.clamp_min(0) + c_log_eps) : c;
-  return normalize(v.flatten(-2), c_mean, c_std).view(c.sizes());
+  return normalize(contact_space(c, c_log_eps).flatten(-2), c_mean, c_std).view(c.sizes());
 }
 
 at::Tensor NormalizationStats::denormalize_c(const at::Tensor& c) const {
@@ -194,9 +198,9 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
       }
       Partial p;
       p.x = moments_of(s.hand_features, frames, kHandFeatureSize, weight.data());
-      p.c = c_log_eps > 0 ? moments_of(at::log(s.contact_maps.to(at::kFloat).clamp_min(0) + c_log_eps).contiguous(),
-                                       frames, 2 * kBasisRows, weight.data())
-                          : moments_of(s.contact_maps, frames, 2 * kBasisRows, weight.data());
+      const at::Tensor c = c_log_eps > 0 ? contact_space(s.contact_maps.to(at::kFloat), c_log_eps).contiguous()
+                                         : s.contact_maps;
+      p.c = moments_of(c, frames, 2 * kBasisRows, weight.data());
       const int64_t rows = s.object_features.size(0);
       std::vector<double> row_weight(static_cast<std::size_t>(rows), 0.0);  // frames sharing an O row
       const int32_t* row_of = s.feature_row.data_ptr<int32_t>();

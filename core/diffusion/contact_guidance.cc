@@ -135,9 +135,8 @@ at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t fir
   if (first < 0 || first + T > points_.size(0))
     throw Error("contact-map guidance: frames [" + std::to_string(first) + ", " + std::to_string(first + T) +
                 ") outside the " + std::to_string(points_.size(0)) + " frames it was made for");
-  at::Tensor out = at::zeros_like(x0, at::kFloat);
   const bool place = step < place_steps_;
-  if (scale_ == 0.0 && !place) return out.to(x0.scalar_type());
+  if (scale_ == 0.0 && !place) return at::zeros_like(x0);
   const at::Tensor H = keypoint_blocks(x0.slice(-1, 0, 600).reshape({B, T, 2, kHandKeypoints, 3}));
   const at::Tensor P = points_.slice(0, first, first + T).contiguous();  // [T, 1024, 3]
   const at::Tensor C = targets(first, T, B).contiguous();                 // [B, T, 2, 1024]
@@ -166,9 +165,7 @@ at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t fir
     const at::Tensor delta = contact_translations(moved, P, C, placement_);  // [B, T, 2, 3]
     step_h = step_h + delta.unsqueeze(3).expand({B, T, 2, kHandKeypoints, 3}).reshape({B, T, 600});
   }
-  out.slice(-1, 0, 600).copy_(step_h);
-  out.slice(-1, 600, 1200).copy_(-step_h);
-  return out.to(x0.scalar_type());
+  return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays
 }
 
 }  // namespace bimart::diffusion
