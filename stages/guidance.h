@@ -31,6 +31,17 @@ class Guidance {
   // Must not modify x0, and must give the same result for the same arguments.
   virtual at::Tensor correction(const at::Tensor& x0, std::int64_t first_frame, int step,
                                 int num_steps) const = 0;
+
+  // A second correction, of the prediction the sampler goes on with: after classifier-free
+  // guidance has combined the conditional and unconditional predictions (and the temporal
+  // band has filtered them). For corrections that set where something is rather than push
+  // it (contact placement): applied before CFG, a translation δ would end up as
+  // (1 + λ_f)·δ. Same arguments and units as `correction`; returns the change [B, T, 1200]
+  // or an undefined tensor for none (the default).
+  virtual at::Tensor placement(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const {
+    (void)x0, (void)first_frame, (void)step, (void)num_steps;
+    return {};
+  }
 };
 
 class GuidanceStage : public Stage {

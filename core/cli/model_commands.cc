@@ -149,20 +149,27 @@ int run_check(const CheckArgs& a) {
       if (auto g = guidance_for(i)) guides.push_back(std::move(g));
     const std::int64_t frames = x0.size(1);
     const at::Tensor band = a.band > 0 && a.band < frames ? diffusion::band_projection(frames, a.band) : at::Tensor();
+    // c (normalised) plus each window's guidance correction (one of the two kinds), in metres.
+    using Correction = at::Tensor (Guidance::*)(const at::Tensor&, std::int64_t, int, int) const;
+    const auto guided = [&](const at::Tensor& c, int t, Correction which) {
+      const at::Tensor m = st.denormalize_x(c);
+      std::vector<at::Tensor> corr;
+      for (int i = 0; i < n; ++i) {
+        corr.push_back(((*guides[i]).*which)(m.slice(0, i, i + 1), 0, t, sched.steps));
+        if (!corr.back().defined()) return c;
+      }
+      return st.normalize_x(m + at::cat(corr, 0));
+    };
     const auto predict = [&](const at::Tensor& x, int t) {
       const at::Tensor tt = at::full({x.size(0)}, t, at::kLong);
       const bool high = !expert.is_empty() && t >= a.expert_from;
       diffusion::DenoiserImpl& d = high ? *expert : *net;
       at::Tensor c = diffusion::predict_x0(d, sched, x, tt, high ? e_cond : cond);
-      if (!guides.empty()) {
-        const at::Tensor m = st.denormalize_x(c);
-        std::vector<at::Tensor> corr;
-        for (int i = 0; i < n; ++i) corr.push_back(guides[i]->correction(m.slice(0, i, i + 1), 0, t, sched.steps));
-        c = st.normalize_x(m + at::cat(corr, 0));
-      }
-      return diffusion::band_limit(
+      if (!guides.empty()) c = guided(c, t, &Guidance::correction);
+      c = diffusion::band_limit(
           cfg ? diffusion::combine_cfg(c, diffusion::predict_x0(d, sched, x, tt, high ? e_uncond : uncond), a.cfg) : c,
           band);
+      return guides.empty() ? c : guided(c, t, &Guidance::placement);  // placement after CFG, as in sampling
     };
     const at::Tensor start =
         a.from < 0 ? at::randn(x0.sizes(), gen)

@@ -127,21 +127,34 @@ at::Tensor ContactMapGuidance::discrepancy(const at::Tensor& x0, std::int64_t fi
   return (dist - targets(first, T, B)).pow(2).mean({1, 2, 3});
 }
 
-at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t first, int step,
-                                          int /*num_steps*/) const {
-  const auto B = x0.size(0), T = x0.size(1);
+void ContactMapGuidance::check_window(const at::Tensor& x0, std::int64_t first) const {
   if (x0.dim() != 3 || x0.size(2) != kHandFeatureSize)
     throw Error("contact-map guidance: x0 must be [B, T, 1200], got " + c10::str(x0.sizes()));
-  if (first < 0 || first + T > points_.size(0))
-    throw Error("contact-map guidance: frames [" + std::to_string(first) + ", " + std::to_string(first + T) +
+  if (first < 0 || first + x0.size(1) > points_.size(0))
+    throw Error("contact-map guidance: frames [" + std::to_string(first) + ", " + std::to_string(first + x0.size(1)) +
                 ") outside the " + std::to_string(points_.size(0)) + " frames it was made for");
-  const bool place = step < place_steps_;
-  if (scale_ == 0.0 && !place) return at::zeros_like(x0);
+}
+
+at::Tensor ContactMapGuidance::placement(const at::Tensor& x0, std::int64_t first, int step, int /*num_steps*/) const {
+  check_window(x0, first);
+  if (step >= place_steps_) return {};
+  const auto B = x0.size(0), T = x0.size(1);
+  const at::Tensor H = x0.slice(-1, 0, 600).to(at::kFloat).reshape({B, T, 2, kHandKeypoints, 3});
+  const at::Tensor delta = contact_translations(H, points_.slice(0, first, first + T), targets(first, T, B), placement_);
+  const at::Tensor step_h = delta.unsqueeze(3).expand({B, T, 2, kHandKeypoints, 3}).reshape({B, T, 600});
+  return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays
+}
+
+at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t first, int /*step*/,
+                                          int /*num_steps*/) const {
+  check_window(x0, first);
+  const auto B = x0.size(0), T = x0.size(1);
+  if (scale_ == 0.0) return at::zeros_like(x0);
   const at::Tensor H = keypoint_blocks(x0.slice(-1, 0, 600).reshape({B, T, 2, kHandKeypoints, 3}));
   const at::Tensor P = points_.slice(0, first, first + T).contiguous();  // [T, 1024, 3]
   const at::Tensor C = targets(first, T, B).contiguous();                 // [B, T, 2, 1024]
-  at::Tensor step_h = at::zeros({B, T, 600}, at::kFloat);
-  if (scale_ != 0.0) {
+  at::Tensor step_h;
+  {
     // d/dh of mean((|p - h*| - c)²) = 2 (d - c) / n · (h* - p) / d, summed onto h*; each
     // block owns its keypoints' gradient, so the parallel blocks never write the same entry.
     const double n = static_cast<double>(T) * 2 * 1024;
@@ -159,11 +172,6 @@ at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t fir
     });
     const at::Tensor norm = grad.reshape({B, -1}).norm(2, 1).clamp_min(1e-12).view({B, 1, 1, 1, 1});
     step_h = (-scale_ * grad / norm).reshape({B, T, 600});
-  }
-  if (place) {
-    const at::Tensor moved = H + step_h.view({B, T, 2, kHandKeypoints, 3});
-    const at::Tensor delta = contact_translations(moved, P, C, placement_);  // [B, T, 2, 3]
-    step_h = step_h + delta.unsqueeze(3).expand({B, T, 2, kHandKeypoints, 3}).reshape({B, T, 600});
   }
   return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays
 }

@@ -27,10 +27,12 @@ class ContactMapGuidance : public Guidance {
   ContactMapGuidance(at::Tensor object_points, at::Tensor target, double scale = 1.0);
 
   // Also translate each hand onto its contacts (core/diffusion/contact_placement.h) at the
-  // last `steps` diffusion steps (0 = never, the paper's method), after the gradient step.
+  // last `steps` diffusion steps (0 = never, the paper's method): `placement`, which the
+  // sampler applies to the prediction after classifier-free guidance.
   void set_placement(int steps, const PlacementOptions& options = {});
 
   at::Tensor correction(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
+  at::Tensor placement(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
 
   // The contact map implied by keypoints H [B, T, 2, J, 3] for object points [T, 1024, 3]:
   // [B, T, 2, 1024], and the index of the nearest keypoint [B, T, 2, 1024].
@@ -42,6 +44,7 @@ class ContactMapGuidance : public Guidance {
 
  private:
   at::Tensor targets(std::int64_t first, std::int64_t T, std::int64_t B) const;
+  void check_window(const at::Tensor& x0, std::int64_t first) const;  // throws unless [B, T, 1200] inside
   at::Tensor points_;  // [N, 1024, 3] float32
   at::Tensor target_;  // [S, N, 2, 1024] float32
   double scale_;

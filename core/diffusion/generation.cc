@@ -167,19 +167,27 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   if (o.band > 0 && o.band < lay.length) band = band_projection(lay.length, o.band);
   // Every window takes its part of the fused sequence (nothing to fuse for one window).
   const auto agree = [&](const at::Tensor& x) { return K == 1 ? x : lay.split(lay.fuse(x)); };
+  // x0 (normalised) plus one of the guidance's corrections, window by window, in metres;
+  // an undefined correction (placement off) leaves x0 as it is.
+  using Correction = at::Tensor (Guidance::*)(const at::Tensor&, std::int64_t, int, int) const;
+  const auto guide = [&](const at::Tensor& x0, int t, Correction which) {
+    const at::Tensor metres = st.denormalize_x(x0);
+    std::vector<at::Tensor> corr;
+    for (std::int64_t k = 0; k < K; ++k) {
+      corr.push_back((guidance->*which)(metres.slice(0, k * S, (k + 1) * S), lay.spans[k].first, t, schedule_.steps));
+      if (!corr.back().defined()) return x0;
+    }
+    return st.normalize_x(metres + at::cat(corr, 0));
+  };
   const auto predict = [&](const at::Tensor& x_t, int t) {
     const at::Tensor xin = cfg ? at::cat({x_t, x_t}, 0) : x_t;
     const at::Tensor out = predict_x0(*net_, schedule_, xin, at::full({xin.size(0)}, t, at::kLong), cond_emb);
     at::Tensor x0 = cfg ? out.slice(0, 0, B) : out;
-    if (guidance != nullptr && motion) {
-      const at::Tensor metres = st.denormalize_x(x0);
-      std::vector<at::Tensor> corr;
-      for (std::int64_t k = 0; k < K; ++k)
-        corr.push_back(guidance->correction(metres.slice(0, k * S, (k + 1) * S), lay.spans[k].first, t, schedule_.steps));
-      x0 = st.normalize_x(metres + at::cat(corr, 0));
-    }
+    if (guidance != nullptr && motion) x0 = guide(x0, t, &Guidance::correction);
     if (cfg) x0 = combine_cfg(x0, out.slice(0, B, 2 * B), o.cfg_lambda);
-    return agree(band_limit(x0, band));
+    x0 = band_limit(x0, band);
+    if (guidance != nullptr && motion) x0 = guide(x0, t, &Guidance::placement);
+    return agree(x0);
   };
   // One noise per sequence frame, so shared frames start equal; fused again after every step.
   const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));

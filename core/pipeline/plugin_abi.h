@@ -12,7 +12,8 @@
 
 #include "core/version.h"
 
-#define BIMART_PLUGIN_ABI_VERSION 1u
+// 2: Guidance::placement (2026-12-03).
+#define BIMART_PLUGIN_ABI_VERSION 2u
 
 namespace bimart {
 class PluginRegistrar;

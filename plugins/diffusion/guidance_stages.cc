@@ -2,7 +2,10 @@
 #include <ATen/ATen.h>
 
 #include "core/diffusion/contact_guidance.h"
+#include "core/diffusion/contact_support.h"
 #include "core/features/contact_map.h"
+#include "core/metrics/articulation.h"
+#include "core/metrics/contact.h"
 #include "core/pipeline/plugin.h"
 #include "stages/guidance.h"
 
@@ -24,10 +27,13 @@ class ContactMapGuidanceStage : public GuidanceStage {
         .param("place_snap", d.snap,
                "m: a hand whose map's minimum is below this (not touching per place_threshold) is placed where its "
                "map is smallest (0 = off)")
+        .param("hold", false,
+               "frames where the object moves (the hinge turns) with no hand's map touching it (its top part): "
+               "the nearest hand is read as touching where its map is smallest (ours; core/diffusion/contact_support.h)")
         .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
   }
   explicit ContactMapGuidanceStage(const Params& p)
-      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))) {
+      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))), hold_(p.boolean("hold")) {
     if (!(scale_ >= 0)) throw Error("'scale' must not be negative");
     if (place_steps_ < 0) throw Error("'place_steps' must not be negative");
     place_.threshold = p.number("place_threshold");
@@ -37,10 +43,16 @@ class ContactMapGuidanceStage : public GuidanceStage {
     place_.validate();
   }
   void run(StageIO& io) override {
-    const at::Tensor points = basis_hit_points(io.in<ArticulatedObject>("object"), io.in<at::Tensor>("object_states"),
-                                               io.in<at::Tensor>("basis_hit_indices"));
-    const at::Tensor target = io.has("contact_maps_samples") ? io.in<at::Tensor>("contact_maps_samples")
-                                                             : io.in<at::Tensor>("contact_maps");
+    const auto& object = io.in<ArticulatedObject>("object");
+    const auto& states = io.in<at::Tensor>("object_states");
+    const auto& hits = io.in<at::Tensor>("basis_hit_indices");
+    const at::Tensor points = basis_hit_points(object, states, hits);
+    at::Tensor target = io.has("contact_maps_samples") ? io.in<at::Tensor>("contact_maps_samples")
+                                                       : io.in<at::Tensor>("contact_maps").unsqueeze(0);
+    if (hold_)
+      target = diffusion::hold_contacts(target, diffusion::around_motion(object_moving_frames(object, states)),
+                                        diffusion::around_motion(angle_changing_frames(states)),
+                                        hits < static_cast<std::int64_t>(object.top.num_vertices()), place_.threshold);
     auto g = std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_);
     g->set_placement(place_steps_, place_);
     io.out("guidance", std::shared_ptr<const Guidance>(std::move(g)));
@@ -49,6 +61,7 @@ class ContactMapGuidanceStage : public GuidanceStage {
  private:
   double scale_;
   int place_steps_;
+  bool hold_;
   diffusion::PlacementOptions place_;
 };
 

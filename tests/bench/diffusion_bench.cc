@@ -21,7 +21,7 @@ namespace {
 // Sizes tried: latent, layers, feed-forward, condition MLP width.
 DenoiserConfig sized(const std::string& model, int which) {
   DenoiserConfig c = DenoiserConfig::paper(model);
-  const int table[4][4] = {{128, 4, 256, 128}, {256, 4, 512, 256}, {384, 6, 768, 384}, {512, 8, 1024, 1024}};
+  const int table[4][4] = {{128, 4, 256, 256}, {256, 4, 512, 256}, {384, 6, 768, 384}, {512, 8, 1024, 1024}};
   c.latent = table[which][0];
   c.layers = table[which][1];
   c.feedforward = table[which][2];
@@ -109,6 +109,8 @@ void BM_DiffusionSampleWindow(benchmark::State& state) {
 }
 BENCHMARK(BM_DiffusionSampleWindow)
     ->Args({3, 1, 0})
+    ->Args({0, 1, 0})
+    ->Args({0, 10, 0})
     ->Args({1, 1, 0})
     ->Args({1, 10, 0})
     ->Args({1, 1, 10})

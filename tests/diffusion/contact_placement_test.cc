@@ -109,8 +109,9 @@ TEST(ContactPlacement, GuidancePlacesOnlyAtItsLastSteps) {
   x0.slice(-1, 0, 600).copy_((truth + 0.02).reshape({1, T, 600}));
   ContactMapGuidance g(P, C, 0.0);
   g.set_placement(3);
-  EXPECT_EQ(g.correction(x0, 0, 3, 50).abs().max().item<double>(), 0.0);  // step 3: not yet
-  const at::Tensor c = g.correction(x0, 0, 2, 50);
+  EXPECT_FALSE(g.placement(x0, 0, 3, 50).defined());  // step 3: not yet
+  EXPECT_EQ(g.correction(x0, 0, 2, 50).abs().max().item<double>(), 0.0);  // scale 0: no gradient step
+  const at::Tensor c = g.placement(x0, 0, 2, 50);
   EXPECT_GT(c.abs().max().item<double>(), 0.01);
   // H moves, and D by the opposite: H + D stays.
   EXPECT_TRUE(at::allclose(c.slice(-1, 0, 600), -c.slice(-1, 600, 1200)));

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/diffusion/generation.h"
+#include "stages/guidance.h"
 #include "core/util/data_path.h"
 #include "tests/diffusion/laptop_trajectory.h"
 
@@ -112,6 +113,37 @@ TEST(Stitching, SameSeedSameMotion) {
   ASSERT_EQ(a.sizes(), (std::vector<int64_t>{2, 120, 2, 1024}));
   EXPECT_TRUE(at::equal(a, b));
   EXPECT_FALSE(at::allclose(a[0], a[1]));  // the samples differ
+}
+
+// A guidance whose placement puts the hands' keypoints exactly at `target` at the last step.
+class PlaceAt : public Guidance {
+ public:
+  explicit PlaceAt(at::Tensor target) : target_(std::move(target)) {}
+  at::Tensor correction(const at::Tensor& x0, std::int64_t, int, int) const override { return at::zeros_like(x0); }
+  at::Tensor placement(const at::Tensor& x0, std::int64_t first, int step, int) const override {
+    if (step > 0) return {};
+    const at::Tensor d = target_.slice(0, first, first + x0.size(1)) - x0.slice(-1, 0, 600);
+    return at::cat({d, -d}, -1);
+  }
+
+ private:
+  at::Tensor target_;  // [N, 600]
+};
+
+TEST(Sampling, PlacementIsAppliedAfterClassifierFreeGuidance) {
+  const EncodedTrajectory l = encoded_laptop_use(64);
+  const auto contact = DiffusionModel::load(find_data_file("models/contact.npz"));
+  const auto motion = DiffusionModel::load(find_data_file("models/motion.npz"));
+  GenerateOptions o;
+  o.sampler.sampler = "ddim";
+  o.sampler.steps = 4;
+  ASSERT_GT(o.cfg_lambda, 0.0);
+  const at::Tensor C = contact->generate(l.O, l.G, {}, nullptr, o, at::detail::createCPUGenerator(5));
+  const at::Tensor target = at::full({64, 600}, 0.05f);
+  const PlaceAt place(target);
+  const at::Tensor X = motion->generate(l.O, l.G, C, &place, o, at::detail::createCPUGenerator(6))[0];
+  // The sample ends where the placement put it, not (1 + λ_f) times as far.
+  EXPECT_LT((X.slice(-1, 0, 600) - target).abs().max().item<double>(), 1e-4);
 }
 
 }  // namespace
