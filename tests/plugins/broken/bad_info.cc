@@ -12,7 +12,7 @@ __attribute__((visibility("default"))) const BimartPluginInfo* bimart_plugin_inf
 #endif
       alignof(BimartPluginInfo),
 #ifdef BAD_FIELD_abi
-      BIMART_PLUGIN_ABI_VERSION + 998,
+      999u,  // a version no bimart has
 #else
       BIMART_PLUGIN_ABI_VERSION,
 #endif
