@@ -6,9 +6,9 @@ set key top right
 set logscale y
 set xlabel 'step (batch 64)'
 set ylabel 'x0 MSE, normalised units'
-set title 'Default diffusion models: training and validation loss (runs/*/loss.csv)'
+set title 'Shipped diffusion models (latent 128): training and validation loss, runs/contact_tiny and runs/motion_tiny' noenhanced
 set grid
-plot 'runs/contact/loss.csv' every ::1 using 1:3 with lines lw 1 lc rgb '#1f77b4' title 'contact: train', \
+plot 'runs/contact_tiny/loss.csv' every ::1 using 1:3 with lines lw 1 lc rgb '#1f77b4' title 'contact: train', \
      '' every ::1 using 1:($4 > 0 ? $4 : 1/0) with linespoints pt 7 ps 0.6 lw 2 lc rgb '#1f77b4' title 'contact: validation', \
-     'runs/motion/loss.csv' every ::1 using 1:3 with lines lw 1 lc rgb '#d62728' title 'motion: train', \
+     'runs/motion_tiny/loss.csv' every ::1 using 1:3 with lines lw 1 lc rgb '#d62728' title 'motion: train', \
      '' every ::1 using 1:($4 > 0 ? $4 : 1/0) with linespoints pt 7 ps 0.6 lw 2 lc rgb '#d62728' title 'motion: validation'
