@@ -16,6 +16,7 @@ void PlacementOptions::validate() const {
   if (min_points < 1) throw Error("contact placement: min_points must be >= 1");
   if (!(sigma >= 0) || !std::isfinite(sigma)) throw Error("contact placement: sigma must be >= 0 (frames)");
   if (!(snap >= 0) || !std::isfinite(snap)) throw Error("contact placement: snap must be >= 0 (metres)");
+  if (!std::isfinite(depth)) throw Error("contact placement: depth must be finite (metres)");
 }
 
 namespace {
@@ -64,7 +65,7 @@ at::Tensor contact_translations(const at::Tensor& keypoints, const at::Tensor& o
     const at::Tensor to_point = Pb - nearest;                                       // k → p
     const at::Tensor d = to_point.norm(2, -1).clamp_min(1e-6);
     // The keypoint's target lies on the segment p → k at distance C from p.
-    const at::Tensor step = to_point * ((1 - C / d) * contact).unsqueeze(-1);       // target − k
+    const at::Tensor step = to_point * ((1 - (C - o.depth) / d) * contact).unsqueeze(-1);  // target − k
     delta = delta + w.unsqueeze(-1) * step.sum(3) / count.clamp_min(1).unsqueeze(-1);
   }
   return smooth_over_frames(delta, w, o.sigma).contiguous();

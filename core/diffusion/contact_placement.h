@@ -23,6 +23,8 @@ struct PlacementOptions {
   // is smallest: its map is read as C − m. (A sampled map is often a blurred one, its
   // minimum a few cm where the data's is 0.) snap <= threshold: off.
   double snap = 0;
+  // m: keypoints are placed this much closer to (> 0: into) the object than their map says.
+  double depth = 0;
   void validate() const;    // throws bimart::Error naming the option
 };
 

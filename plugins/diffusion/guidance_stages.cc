@@ -27,6 +27,7 @@ class ContactMapGuidanceStage : public GuidanceStage {
         .param("place_snap", d.snap,
                "m: a hand whose map's minimum is below this (not touching per place_threshold) is placed where its "
                "map is smallest (0 = off)")
+        .param("place_depth", d.depth, "m: place keypoints this much closer to (> 0: into) the object than C says")
         .param("hold", false,
                "frames where the object moves (the hinge turns) with no hand's map touching it (its top part): "
                "the nearest hand is read as touching where its map is smallest (ours; core/diffusion/contact_support.h)")
@@ -40,6 +41,7 @@ class ContactMapGuidanceStage : public GuidanceStage {
     place_.sigma = p.number("place_sigma");
     place_.iterations = static_cast<int>(p.integer("place_iterations"));
     place_.snap = p.number("place_snap");
+    place_.depth = p.number("place_depth");
     place_.validate();
   }
   void run(StageIO& io) override {

@@ -63,6 +63,21 @@ TEST(ContactPlacement, TranslatesAHoveringHandBackOntoItsContacts) {
   EXPECT_LT(after.item<double>(), 0.2 * before.item<double>());
 }
 
+TEST(ContactPlacement, DepthPlacesTheHandThatMuchCloser) {
+  const int T = 3;
+  const at::Tensor P = sphere_points().unsqueeze(0).expand({T, 1024, 3}).contiguous();
+  const at::Tensor truth = wrapping_hand().view({1, 1, 1, 100, 3}).expand({1, T, 2, 100, 3}).contiguous();
+  const at::Tensor C = ContactMapGuidance::keypoint_contact_map(truth, P).first;
+  PlacementOptions o;
+  o.iterations = 30;
+  o.depth = 0.002;  // the hand wraps the sphere at 2 mm: placed 2 mm deeper, it moves ~2 mm towards -x
+  const at::Tensor delta = contact_translations(truth, P, C, o);
+  EXPECT_NEAR(delta.select(-1, 0).mean().item<double>(), -0.002, 0.0008) << delta[0][0];
+  EXPECT_LT(delta.select(-1, 1).abs().max().item<double>(), 0.0005);
+  o.depth = std::nan("");
+  EXPECT_THROW(contact_translations(truth, P, C, o), Error);
+}
+
 TEST(ContactPlacement, FramesWithoutContactsStayAndTheTranslationFadesIntoThem) {
   const int T = 40;
   const at::Tensor P = sphere_points().unsqueeze(0).expand({T, 1024, 3}).contiguous();
