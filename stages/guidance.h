@@ -44,6 +44,10 @@ class Guidance {
   }
 };
 
+// Either of Guidance's two corrections (`&Guidance::correction`, `&Guidance::placement`), for
+// samplers that apply both the same way, window by window.
+using GuidanceCorrection = at::Tensor (Guidance::*)(const at::Tensor&, std::int64_t, int, int) const;
+
 class GuidanceStage : public Stage {
  public:
   static constexpr const char* kKind = "guidance";

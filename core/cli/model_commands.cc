@@ -150,8 +150,7 @@ int run_check(const CheckArgs& a) {
     const std::int64_t frames = x0.size(1);
     const at::Tensor band = a.band > 0 && a.band < frames ? diffusion::band_projection(frames, a.band) : at::Tensor();
     // c (normalised) plus each window's guidance correction (one of the two kinds), in metres.
-    using Correction = at::Tensor (Guidance::*)(const at::Tensor&, std::int64_t, int, int) const;
-    const auto guided = [&](const at::Tensor& c, int t, Correction which) {
+      const auto guided = [&](const at::Tensor& c, int t, GuidanceCorrection which) {
       const at::Tensor m = st.denormalize_x(c);
       std::vector<at::Tensor> corr;
       for (int i = 0; i < n; ++i) {

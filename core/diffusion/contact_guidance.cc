@@ -153,26 +153,23 @@ at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t fir
   const at::Tensor H = keypoint_blocks(x0.slice(-1, 0, 600).reshape({B, T, 2, kHandKeypoints, 3}));
   const at::Tensor P = points_.slice(0, first, first + T).contiguous();  // [T, 1024, 3]
   const at::Tensor C = targets(first, T, B).contiguous();                 // [B, T, 2, 1024]
-  at::Tensor step_h;
-  {
-    // d/dh of mean((|p - h*| - c)²) = 2 (d - c) / n · (h* - p) / d, summed onto h*; each
-    // block owns its keypoints' gradient, so the parallel blocks never write the same entry.
-    const double n = static_cast<double>(T) * 2 * 1024;
-    at::Tensor grad = at::zeros_like(H);
-    float* g = grad.data_ptr<float>();
-    const float* h = H.data_ptr<float>();
-    const float* c = C.data_ptr<float>();
-    const float* p = P.data_ptr<float>();
-    for_each_nearest(H, P, [&](std::int64_t blk, std::int64_t m, std::int64_t best, float dm) {
-      const float coef = static_cast<float>(2.0 / n) * (dm - c[blk * 1024 + m]) / std::max(dm, 1e-6f);
-      const float* k = h + (blk * kHandKeypoints + best) * 3;
-      const float* pt = p + (((blk / 2) % T) * 1024 + m) * 3;
-      float* gk = g + (blk * kHandKeypoints + best) * 3;
-      for (int a = 0; a < 3; ++a) gk[a] += coef * (k[a] - pt[a]);
-    });
-    const at::Tensor norm = grad.reshape({B, -1}).norm(2, 1).clamp_min(1e-12).view({B, 1, 1, 1, 1});
-    step_h = (-scale_ * grad / norm).reshape({B, T, 600});
-  }
+  // d/dh of mean((|p - h*| - c)²) = 2 (d - c) / n · (h* - p) / d, summed onto h*; each
+  // block owns its keypoints' gradient, so the parallel blocks never write the same entry.
+  const double n = static_cast<double>(T) * 2 * 1024;
+  at::Tensor grad = at::zeros_like(H);
+  float* g = grad.data_ptr<float>();
+  const float* h = H.data_ptr<float>();
+  const float* c = C.data_ptr<float>();
+  const float* p = P.data_ptr<float>();
+  for_each_nearest(H, P, [&](std::int64_t blk, std::int64_t m, std::int64_t best, float dm) {
+    const float coef = static_cast<float>(2.0 / n) * (dm - c[blk * 1024 + m]) / std::max(dm, 1e-6f);
+    const float* k = h + (blk * kHandKeypoints + best) * 3;
+    const float* pt = p + (((blk / 2) % T) * 1024 + m) * 3;
+    float* gk = g + (blk * kHandKeypoints + best) * 3;
+    for (int a = 0; a < 3; ++a) gk[a] += coef * (k[a] - pt[a]);
+  });
+  const at::Tensor norm = grad.reshape({B, -1}).norm(2, 1).clamp_min(1e-12).view({B, 1, 1, 1, 1});
+  const at::Tensor step_h = (-scale_ * grad / norm).reshape({B, T, 600});
   return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays
 }
 

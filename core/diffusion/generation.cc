@@ -169,8 +169,7 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   const auto agree = [&](const at::Tensor& x) { return K == 1 ? x : lay.split(lay.fuse(x)); };
   // x0 (normalised) plus one of the guidance's corrections, window by window, in metres;
   // an undefined correction (placement off) leaves x0 as it is.
-  using Correction = at::Tensor (Guidance::*)(const at::Tensor&, std::int64_t, int, int) const;
-  const auto guide = [&](const at::Tensor& x0, int t, Correction which) {
+  const auto guide = [&](const at::Tensor& x0, int t, GuidanceCorrection which) {
     const at::Tensor metres = st.denormalize_x(x0);
     std::vector<at::Tensor> corr;
     for (std::int64_t k = 0; k < K; ++k) {
