@@ -23,6 +23,7 @@
 #include "core/io/sequence.h"
 #include "core/metrics/accel.h"
 #include "core/metrics/hand_vertices.h"
+#include "core/metrics/held_frames.h"
 #include "core/metrics/sequence_metrics.h"
 #include "core/object/object_cache.h"
 #include "core/refine/mano_fit.h"
@@ -109,7 +110,8 @@ PerSequence process(const RefineCliOptions& o, const std::array<const HandModel*
   auto t1 = std::chrono::steady_clock::now();
   RefineOptions refine_options = o.refine;
   refine_options.threads = 1;
-  const HandMotion refined = refine_hands(models, distance, s.object_states, X, fit, refine_options, &r.report);
+  const HeldFrames held = refine_options.w_hold > 0 ? held_frames(object, s.object_states) : HeldFrames{};
+  const HandMotion refined = refine_hands(models, distance, s.object_states, X, fit, refine_options, &r.report, held);
   auto t2 = std::chrono::steady_clock::now();
   r.seconds_fit = std::chrono::duration<double>(t1 - t0).count();
   r.seconds_refine = std::chrono::duration<double>(t2 - t1).count();
@@ -256,6 +258,8 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--w-pen", o.refine.w_pen, "refinement: penetration weight (grows while too deep)")->capture_default_str();
   cmd->add_option("--w-acc", o.refine.w_acc, "refinement: acceleration weight")->capture_default_str();
   cmd->add_option("--w-fit", o.refine.w_fit, "refinement: keypoint weight")->capture_default_str();
+  cmd->add_option("--w-hold", o.refine.w_hold, "refinement: hold weight (a hand on the object where it moves; 0 = off)")
+      ->capture_default_str();
   cmd->add_option("--rounds", o.refine.outer_iterations, "refinement: surface linearisations")->capture_default_str();
   cmd->add_option("--steps", o.refine.max_iterations, "refinement: solver steps per round")->capture_default_str();
   cmd->add_option("--noise", o.corruption.noise, "corruption: RMS keypoint error (m)")->capture_default_str();

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/diffusion/contact_support.h"
 #include "core/features/hand_features.h"
 #include "core/util/error.h"
 
@@ -31,6 +32,21 @@ void ContactMapGuidance::set_placement(int steps, const PlacementOptions& option
   options.validate();
   place_steps_ = steps;
   placement_ = options;
+}
+
+void ContactMapGuidance::set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach) {
+  const auto N = points_.size(0);
+  if (static_cast<std::int64_t>(held.size()) != N || static_cast<std::int64_t>(turning.size()) != N ||
+      top.dim() != 2 || top.size(0) != N || top.size(1) != points_.size(1))
+    throw Error("contact-map guidance: support needs " + std::to_string(N) + " held and turning flags and top [" +
+                std::to_string(N) + ", " + std::to_string(points_.size(1)) + "], got " + std::to_string(held.size()) +
+                ", " + std::to_string(turning.size()) + " and " + c10::str(top.sizes()));
+  if (!(reach > 0) || !std::isfinite(reach)) throw Error("contact-map guidance: support reach must be > 0 (metres)");
+  support_ = true;
+  held_ = std::move(held);
+  turning_ = std::move(turning);
+  top_ = top.to(at::kBool).contiguous();
+  reach_ = reach;
 }
 
 namespace {
@@ -140,7 +156,13 @@ at::Tensor ContactMapGuidance::placement(const at::Tensor& x0, std::int64_t firs
   if (step >= place_steps_) return {};
   const auto B = x0.size(0), T = x0.size(1);
   const at::Tensor H = x0.slice(-1, 0, 600).to(at::kFloat).reshape({B, T, 2, kHandKeypoints, 3});
-  const at::Tensor delta = contact_translations(H, points_.slice(0, first, first + T), targets(first, T, B), placement_);
+  const at::Tensor P = points_.slice(0, first, first + T);
+  at::Tensor delta = contact_translations(H, P, targets(first, T, B), placement_);
+  if (support_) {
+    const auto frames = [&](const std::vector<bool>& v) { return std::vector<bool>(v.begin() + first, v.begin() + first + T); };
+    delta = delta + support_translations(H + delta.unsqueeze(3), P, frames(held_), frames(turning_),
+                                         top_.slice(0, first, first + T), reach_, placement_.sigma);
+  }
   const at::Tensor step_h = delta.unsqueeze(3).expand({B, T, 2, kHandKeypoints, 3}).reshape({B, T, 600});
   return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays
 }

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <ATen/core/Tensor.h>
 
@@ -30,6 +31,10 @@ class ContactMapGuidance : public Guidance {
   // last `steps` diffusion steps (0 = never, the paper's method): `placement`, which the
   // sampler applies to the prediction after classifier-free guidance.
   void set_placement(int steps, const PlacementOptions& options = {});
+  // With the placement, also put a hand on the object where it must be held and none is
+  // (core/diffusion/contact_support.h, support_translations): `held` and `turning` per frame
+  // (N each), `top` [N, 1024] bool (the point lies on the top part), `reach` m.
+  void set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach);
 
   at::Tensor correction(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
   at::Tensor placement(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
@@ -50,6 +55,10 @@ class ContactMapGuidance : public Guidance {
   double scale_;
   int place_steps_ = 0;
   PlacementOptions placement_;
+  bool support_ = false;
+  std::vector<bool> held_, turning_;
+  at::Tensor top_;  // [N, 1024] bool
+  double reach_ = 0.01;
 };
 
 }  // namespace bimart::diffusion

@@ -19,11 +19,6 @@ void PlacementOptions::validate() const {
   if (!std::isfinite(depth)) throw Error("contact placement: depth must be finite (metres)");
 }
 
-namespace {
-
-// Per-frame translations δ [B, T, 2, 3] with weights w [B, T, 2] (1 where the frame had
-// contacts) smoothed over frames: Σ g w δ / max(Σ g w, 1) with g(0) = 1, so inside a
-// stretch of contacts it is a weighted mean and it fades to 0 within ~σ frames outside.
 at::Tensor smooth_over_frames(const at::Tensor& delta, const at::Tensor& w, double sigma) {
   if (sigma <= 0) return delta * w.unsqueeze(-1);
   const std::int64_t T = delta.size(1);
@@ -33,8 +28,6 @@ at::Tensor smooth_over_frames(const at::Tensor& delta, const at::Tensor& w, doub
   const at::Tensor den = at::einsum("ts,bsh->bth", {g, w}).clamp_min(1.0);
   return num / den.unsqueeze(-1);
 }
-
-}  // namespace
 
 at::Tensor contact_translations(const at::Tensor& keypoints, const at::Tensor& object_points,
                                 const at::Tensor& contact_maps, const PlacementOptions& o) {

@@ -33,4 +33,10 @@ struct PlacementOptions {
 at::Tensor contact_translations(const at::Tensor& keypoints, const at::Tensor& object_points,
                                 const at::Tensor& contact_maps, const PlacementOptions& options = {});
 
+// Per-frame translations δ [B, T, 2, 3] with weights w [B, T, 2] (1 where a frame has one)
+// smoothed over frames: Σ g w δ / max(Σ g w, 1), g a Gaussian of `sigma` frames with
+// g(0) = 1, so inside a stretch of weighted frames it is a weighted mean and it fades to 0
+// within ~σ frames outside. sigma 0: δ·w.
+at::Tensor smooth_over_frames(const at::Tensor& delta, const at::Tensor& w, double sigma);
+
 }  // namespace bimart::diffusion

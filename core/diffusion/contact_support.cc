@@ -2,9 +2,12 @@
 
 #include <ATen/ATen.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 
+#include "core/diffusion/contact_guidance.h"
+#include "core/diffusion/contact_placement.h"
 #include "core/util/error.h"
 
 namespace bimart::diffusion {
@@ -30,6 +33,9 @@ at::Tensor shift_nearest(const at::Tensor& C, const at::Tensor& need, const at::
   return (C - shift.unsqueeze(-1) * w.to(at::kFloat)).clamp_min(0);
 }
 
+constexpr int kSupportRounds = 4;    // rounds of support_translations
+constexpr int kSupportKeypoint = 3;  // a hand's distance is its 3rd nearest keypoint's
+
 }  // namespace
 
 at::Tensor hold_contacts(const at::Tensor& maps, const std::vector<bool>& held, const std::vector<bool>& turning,
@@ -47,11 +53,55 @@ at::Tensor hold_contacts(const at::Tensor& maps, const std::vector<bool>& held, 
   return shift_nearest(C, frame_mask(turning), is_top, threshold).contiguous();
 }
 
-std::vector<bool> around_motion(const std::vector<bool>& moving) {
-  std::vector<bool> held(moving.size(), false);
-  for (size_t t = 0; t < moving.size(); ++t)
-    held[t] = moving[t] || (t > 0 && moving[t - 1]);
-  return held;
+at::Tensor support_translations(const at::Tensor& keypoints, const at::Tensor& object_points,
+                                const std::vector<bool>& held, const std::vector<bool>& turning, const at::Tensor& top,
+                                double reach, double sigma) {
+  const at::Tensor H = keypoints.to(at::kFloat);
+  const at::Tensor P = object_points.to(at::kFloat);
+  if (H.dim() != 5 || H.size(2) != 2 || H.size(4) != 3 || P.dim() != 3 || P.size(0) != H.size(1) || P.size(2) != 3 ||
+      top.dim() != 2 || top.size(0) != P.size(0) || top.size(1) != P.size(1) ||
+      static_cast<std::int64_t>(held.size()) != H.size(1) || static_cast<std::int64_t>(turning.size()) != H.size(1))
+    throw Error("support placement: need keypoints [B, T, 2, J, 3], object points [T, M, 3], top [T, M] and T held "
+                "and turning flags, got " + c10::str(H.sizes()) + ", " + c10::str(P.sizes()) + ", " +
+                c10::str(top.sizes()) + ", " + std::to_string(held.size()) + " and " + std::to_string(turning.size()));
+  if (!(reach > 0) || !std::isfinite(reach)) throw Error("support placement: reach must be > 0 (metres)");
+  if (!(sigma >= 0) || !std::isfinite(sigma)) throw Error("support placement: sigma must be >= 0 (frames)");
+  const std::int64_t B = H.size(0), T = H.size(1), J = H.size(3), M = P.size(1);
+  const float inf = std::numeric_limits<float>::infinity();
+  const at::Tensor is_top = top.to(at::kBool);
+  const std::pair<at::Tensor, at::Tensor> passes[] = {{frame_mask(held), at::ones_like(is_top)},
+                                                      {frame_mask(turning), is_top}};
+  // Smoothing shortens the moves near the ends of a stretch and between frames whose
+  // nearest points differ, so the frames still apart are moved again (a few rounds).
+  at::Tensor total = at::zeros({B, T, 2, 3}, at::kFloat);
+  for (int round = 0; round < kSupportRounds; ++round) {
+    at::Tensor delta = at::zeros({B, T, 2, 3}, at::kFloat);
+    at::Tensor w = at::zeros({B, T, 2}, at::kFloat);
+    for (const auto& [need_frame, where] : passes) {
+      const at::Tensor Hd = H + (total + delta).unsqueeze(3);
+      // Each keypoint's nearest object point (among `where`), sample by sample.
+      at::Tensor gap = at::empty({B, T, 2, J}, at::kFloat), near = at::empty({B, T, 2, J}, at::kLong);
+      for (std::int64_t b = 0; b < B; ++b) {
+        const at::Tensor d = at::cdist(Hd[b].reshape({T, 2 * J, 3}), P).masked_fill(~where.view({T, 1, M}), inf);
+        const auto [v, i] = d.min(-1);  // [T, 2J]
+        gap[b] = v.view({T, 2, J});
+        near[b] = i.view({T, 2, J});
+      }
+      // A hand's distance: its k-th nearest keypoint's (not the nearest: a stray keypoint
+      // far from the others is not where the fitted hand will be).
+      const auto [hand_gap, kp] = gap.kthvalue(std::min<std::int64_t>(kSupportKeypoint, J), -1);  // [B, T, 2]
+      const at::Tensor need = (hand_gap >= reach).all(-1) & need_frame.view({1, T}) & at::isfinite(hand_gap).any(-1);
+      const at::Tensor move = at::one_hot(hand_gap.argmin(-1), 2).to(at::kBool) & need.unsqueeze(-1);  // [B, T, 2]
+      const at::Tensor k = Hd.gather(3, kp.view({B, T, 2, 1, 1}).expand({B, T, 2, 1, 3})).squeeze(3);
+      const at::Tensor pi = near.gather(3, kp.unsqueeze(-1)).squeeze(-1);  // [B, T, 2]
+      const at::Tensor p = P.view({1, T, 1, M, 3}).expand({B, T, 2, M, 3}).gather(3, pi.view({B, T, 2, 1, 1}).expand({B, T, 2, 1, 3})).squeeze(3);
+      delta = delta + (p - k) * move.unsqueeze(-1).to(at::kFloat);
+      w = at::maximum(w, move.to(at::kFloat));
+    }
+    if (!w.any().item<bool>()) break;
+    total = total + smooth_over_frames(delta, w, sigma);
+  }
+  return total.contiguous();
 }
 
 }  // namespace bimart::diffusion

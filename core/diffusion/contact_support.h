@@ -11,6 +11,8 @@
 
 #include <ATen/core/Tensor.h>
 
+#include "core/metrics/held_frames.h"  // around_motion, held_frames
+
 namespace bimart::diffusion {
 
 // maps [S, N, 2, M] (metres), held and turning: per frame (N each), top [N, M] bool (the
@@ -18,8 +20,16 @@ namespace bimart::diffusion {
 at::Tensor hold_contacts(const at::Tensor& maps, const std::vector<bool>& held, const std::vector<bool>& turning,
                          const at::Tensor& top, double threshold);
 
-// Frames that must be held: frame t when the object moves from t - 1 to t or from t to t + 1
-// (`moving` as core/metrics' object_moving_frames / angle_changing_frames give it).
-std::vector<bool> around_motion(const std::vector<bool>& moving);
+// Support placement: the translations [B, T, 2, 3] that put a hand on the object where it
+// must be held, from the keypoints themselves rather than the maps. In a `held` frame where
+// no hand comes within `reach` of the object points P [T, M, 3], the hand that comes
+// nearest is moved by the vector from its keypoint to that keypoint's nearest point (so the
+// two meet). A hand's distance is its 3rd nearest keypoint's, not its nearest: the model
+// leaves a stray keypoint now and then, and the fitted hand is where the others are; then the same over the top part's points (`top` [T, M] bool) in `turning` frames.
+// Smoothed over frames like contact_translations (sigma in frames). keypoints [B, T, 2, J, 3].
+at::Tensor support_translations(const at::Tensor& keypoints, const at::Tensor& object_points,
+                                const std::vector<bool>& held, const std::vector<bool>& turning, const at::Tensor& top,
+                                double reach, double sigma);
+
 
 }  // namespace bimart::diffusion

@@ -43,6 +43,8 @@ struct FrameTerms {
   std::vector<double> pen_scale;  // their residual scales (s_pen × the vertex's boost)
   std::array<Plane, kJ> proj;   // per keypoint: the plane nearest K + D̂
   std::vector<double> pos, jac;  // posed [3S] and d/dx [3S × 51] at the current point
+  int hold_k = -1;               // held frame: the keypoint pulled onto the surface
+  Plane hold;                    // its plane
 };
 
 struct HandData {
@@ -54,7 +56,8 @@ struct HandData {
   std::vector<int> kp_ids, acc_ids;  // vertex ids
   std::vector<int> acc_rows;         // row of each acceleration vertex in every frame's subset
   std::vector<FrameTerms> frames;
-  double s_fit = 0, s_proj = 0, s_pen = 0, s_acc = 0;  // residual scales (√weight/count)
+  double s_fit = 0, s_proj = 0, s_pen = 0, s_acc = 0, s_hold = 0;  // residual scales (√weight/count)
+  std::vector<int> hold_part;  // per frame: -1, or the ObjectPart this hand is held to
   // Per frame: the penetration weight multiplier (grows while the frame stays too deep).
   std::vector<double> pen_boost;
 };
@@ -238,6 +241,35 @@ class AccelCost : public ceres::CostFunction {
   std::vector<int> rows_;
 };
 
+// The hold row of one frame: its keypoint's distance outside the surface plane (0 inside).
+class HoldCost : public ceres::CostFunction {
+ public:
+  HoldCost(const HandData* d, int64_t t, std::vector<Block> blocks) : d_(d), t_(t), blocks_(std::move(blocks)) {
+    set_num_residuals(1);
+    for (const Block& b : blocks_) mutable_parameter_block_sizes()->push_back(b.size);
+  }
+  bool Evaluate(double const* const*, double* r, double** J) const override {
+    const FrameTerms& f = d_->frames[static_cast<size_t>(t_)];
+    const int k = f.hold_k;
+    const Eigen::Vector3d v(f.pos[3 * k], f.pos[3 * k + 1], f.pos[3 * k + 2]);
+    const double out = f.hold.normal.dot(v - f.hold.point);
+    r[0] = out > 0 ? d_->s_hold * out : 0.0;
+    if (J) {
+      double row[kX];
+      const double *a = jac_row(f, k, 0), *b = jac_row(f, k, 1), *c = jac_row(f, k, 2);
+      const Eigen::Vector3d& n = f.hold.normal;
+      for (int i = 0; i < kX; ++i) row[i] = n.x() * a[i] + n.y() * b[i] + n.z() * c[i];
+      write_row(row, out > 0 ? d_->s_hold : 0.0, blocks_, 0, J);
+    }
+    return true;
+  }
+
+ private:
+  const HandData* d_;
+  int64_t t_;
+  std::vector<Block> blocks_;
+};
+
 Points3 pose_all(const LbsSubset& all, const double* x, const double* beta) {
   Points3 v(all.size(), 3);
   lbs_subset(all, x, x + 3, x + 48, beta, v.data());
@@ -262,7 +294,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   const int64_t N = d->N;
   const int V = all.size();
   Evaluation e;
-  double proj = 0, pen = 0, acc = 0, fit = 0, kerr = 0;
+  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, kerr = 0;
   std::vector<Points3> acc_points;
   for (int64_t t = 0; t < N; ++t) {
     const Points3 v = pose_all(all, d->x.data() + t * kX, d->beta.data());
@@ -278,6 +310,20 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
       const ObjectSurfaceQuery q = dist.query(st, K + Dt);
       proj += q.signed_distance * q.signed_distance;
       if (f) f->proj[static_cast<size_t>(k)] = plane_of(q);
+    }
+    if (d->hold_part[static_cast<size_t>(t)] >= 0) {  // the keypoint nearest the part
+      const auto part = static_cast<ObjectPart>(d->hold_part[static_cast<size_t>(t)]);
+      ObjectSurfaceQuery best;
+      int best_k = -1;
+      for (int k = 0; k < kJ; ++k) {
+        const ObjectSurfaceQuery q = dist.query(st, v.row(d->kp_ids[static_cast<size_t>(k)]).transpose(), part);
+        if (best_k < 0 || q.signed_distance > best.signed_distance) best = q, best_k = k;
+      }
+      if (best.signed_distance < 0) hold += best.signed_distance * best.signed_distance;
+      if (f) {
+        f->hold_k = best_k;
+        f->hold = plane_of(best);
+      }
     }
     const auto near = dist.near_surface(st, v, relinearise ? o.pen_margin : 0.0);
     for (const auto& [i, q] : near)
@@ -332,6 +378,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   e.terms.proj = o.w_proj * proj / nk;
   e.terms.pen = o.w_pen * pen / nk;
   e.terms.fit = o.w_fit * fit / nk;
+  e.terms.hold = o.w_hold * hold / static_cast<double>(N);
   e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
   e.keypoint_error = kerr / nk;
   return e;
@@ -358,6 +405,8 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     return ev;
   };
   d->s_pen = std::sqrt(2 * o.w_pen / nk);
+  d->s_hold = std::sqrt(2 * o.w_hold / static_cast<double>(d->N));
+  for (int p : d->hold_part) rep->held_frames += p >= 0;
   d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
   rep->before = e.terms;
@@ -385,6 +434,10 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         const std::vector<Block> blocks = blocks_of(mask);
         problem.AddResidualBlock(new FrameCost(d, t, blocks, std::move(g.first), std::move(g.second)), nullptr,
                                  block_pointers(x, blocks));
+      }
+      if (f.hold_k >= 0 && o.w_hold > 0) {
+        const std::vector<Block> blocks = blocks_of(masks[static_cast<size_t>(d->kp_ids[static_cast<size_t>(f.hold_k)])]);
+        problem.AddResidualBlock(new HoldCost(d, t, blocks), nullptr, block_pointers(x, blocks));
       }
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {
@@ -439,6 +492,36 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   rep->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Per hand and frame, the part it is held to (HandData::hold_part): in a held (turning)
+// frame, the starting hand nearer the object (its top part); the term only pulls a hand
+// from outside, so one that touches or is inside costs nothing. The top part wins over the whole object for a hand chosen twice.
+void assign_holds(const std::array<const HandModel*, 2>& models, const ObjectDistance& dist,
+                  const std::vector<ObjectState>& states, const HandMotion& start, const HeldFrames& held,
+                  const RefineOptions& o, std::array<HandData, 2>* data) {
+  const std::size_t N = states.size();
+  for (HandData& d : *data) d.hold_part.assign(N, -1);
+  if (o.w_hold == 0 || (held.held.empty() && held.turning.empty())) return;
+  if ((!held.held.empty() && held.held.size() != N) || (!held.turning.empty() && held.turning.size() != N))
+    throw Error("refinement: held frames need " + std::to_string(N) + " flags each, got " +
+                std::to_string(held.held.size()) + " and " + std::to_string(held.turning.size()));
+  const at::Tensor V =
+      (start.has_vertices() ? start.vertices : pose_hand_vertices(models, start)).to(at::kDouble).contiguous();
+  const auto Vn = static_cast<Eigen::Index>(V.size(2));
+  const std::pair<ObjectPart, const std::vector<bool>*> passes[] = {{ObjectPart::Whole, &held.held},
+                                                                    {ObjectPart::Top, &held.turning}};
+  for (std::size_t t = 0; t < N; ++t)
+    for (const auto& [part, flags] : passes) {
+      if (flags->empty() || !(*flags)[t]) continue;
+      double sd[2];
+      for (int h = 0; h < 2; ++h) {
+        const Eigen::Map<const Points3> v(V[h][static_cast<int64_t>(t)].data_ptr<double>(), Vn, 3);
+        sd[h] = dist.max_signed_distance(states[t], v, part);
+      }
+      int& p = (*data)[sd[0] >= sd[1] ? 0 : 1].hold_part[t];
+      if (part == ObjectPart::Top || p < 0) p = static_cast<int>(part);
+    }
+}
+
 std::vector<double> as_vector(const at::Tensor& t) {
   const at::Tensor c = t.to(at::kCPU, at::kDouble).contiguous();
   return std::vector<double>(c.data_ptr<double>(), c.data_ptr<double>() + c.numel());
@@ -455,6 +538,7 @@ void RefineOptions::validate() const {
   nonneg(w_pen, "w_pen");
   nonneg(w_acc, "w_acc");
   nonneg(w_fit, "w_fit");
+  nonneg(w_hold, "w_hold");
   nonneg(pen_margin, "pen_margin");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
   if (max_outer_iterations < 0) throw Error("refinement: max_outer_iterations must be >= 0");
@@ -467,7 +551,7 @@ void RefineOptions::validate() const {
 
 HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const ObjectDistance& distance, const at::Tensor& states,
                         const at::Tensor& keypoints, const HandMotion& start,
-                        const RefineOptions& options, RefineReport* report) {
+                        const RefineOptions& options, RefineReport* report, const HeldFrames& held) {
   options.validate();
   const int64_t N = start.num_frames();
   if (N < 1) throw Error("refinement: the starting motion has no frames");
@@ -494,6 +578,7 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
     d.kp_ids = model_keypoints(*d.model);
     d.acc_ids = hand_keypoints(*d.model, options.accel_vertices);
   }
+  assign_holds(models, distance, data[0].states, start, held, options, &data);
   RefineReport local;
   parallel_for(2, resolve_threads(options.threads), [&](std::size_t h) { refine_hand(&data[h], distance, options, &local.hands[h]); });
 
@@ -509,10 +594,11 @@ std::string format_refine_report(const RefineReport& r) {
   for (int h = 0; h < 2; ++h) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
-        "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}; "
+        "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}, "
+        "hold {:.3g} -> {:.3g} ({} frames); "
         "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
-        x.after.acc, x.before.fit, x.after.fit, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
         x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;

@@ -7,6 +7,7 @@
 //   w_pen  · Σ_{t, v inside} depth_tv² / (N·J)           hand vertices inside the object
 //   w_acc  · mean_{t,a} ||v_ta − 2 v_t−1,a + v_t−2,a||²  second differences of hand vertices
 //   w_fit  · mean_{t,k} ||K_tk − Ĥ_tk||²                 keypoints near the prediction (ours)
+//   w_hold · Σ_{t held} max(0, −sd(K_t*))² / N           a hand on the object where it must be (ours)
 // The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
 // converges, so it squares them and adds the fit term to hold what the other terms leave
 // free (a contact constrains a keypoint along the surface normal only). Its weights
@@ -25,15 +26,22 @@
 // mean over them estimates the mean over all vertices); β stays at the fit's value.
 // Per evaluation, each frame's vertices and Jacobians are posed once (Jets through
 // lbs_subset) and shared by all terms that read that frame.
+//
+// Hold (ours, off by default): an object moves only while a hand holds it, and its top
+// part turns only while a hand is on it. In such frames (HeldFrames) the starting hand
+// nearer the object (its top part) is held to it: its keypoint nearest the object (the top
+// part), re-chosen every round, is pulled onto the surface from outside.
 #pragma once
 
 #include <array>
 #include <string>
+#include <vector>
 
 #include <ATen/core/Tensor.h>
 
 #include "core/hand/hand_model.h"
 #include "core/hand/hand_motion.h"
+#include "core/metrics/held_frames.h"
 #include "core/object/articulated_object.h"
 #include "core/object/object_distance.h"
 
@@ -56,13 +64,14 @@ struct RefineOptions {
   double pen_margin = 0.005;   // m: vertices closer than this to the surface get a plane
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
+  double w_hold = 0;           // the hold term (ours; 0 = off, the paper's)
   void validate() const;       // throws bimart::Error naming the option
 };
 
 // The terms of the cost as defined above, weighted, with exact surface distances.
 struct RefineTerms {
-  double proj = 0, pen = 0, acc = 0, fit = 0;
-  double total() const { return proj + pen + acc + fit; }
+  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0;
+  double total() const { return proj + pen + acc + fit + hold; }
 };
 struct RefineHandReport {
   RefineTerms before, after;
@@ -71,6 +80,7 @@ struct RefineHandReport {
   int iterations = 0;                                // LM steps over all outer iterations
   int outer_iterations = 0;
   double max_pen_boost = 1;                          // largest weight multiplier reached
+  int held_frames = 0;                               // frames this hand was held in
   double seconds = 0;
   double surface_seconds = 0;  // of which: surface queries and linearisation
 };
@@ -80,11 +90,13 @@ struct RefineReport {
 };
 
 // keypoints X [N, 1200] (canonical frame, DESIGN §4), states [N, 7], start: a fit (world
-// frame), `distance`: the object's (built once per object). Returns the refined motion
-// with posed vertices. Throws bimart::Error for inputs whose shapes disagree.
+// frame), `distance`: the object's (built once per object), `held`: where the hold
+// term applies (core/metrics/held_frames.h; empty: nowhere). Returns the refined motion with
+// posed vertices. Throws bimart::Error for inputs whose shapes disagree.
 HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const ObjectDistance& distance, const at::Tensor& states,
                         const at::Tensor& keypoints, const HandMotion& start,
-                        const RefineOptions& options = {}, RefineReport* report = nullptr);
+                        const RefineOptions& options = {}, RefineReport* report = nullptr,
+                        const HeldFrames& held = {});
 
 // One line per hand: the terms before → after, depth and keypoint error (for logs).
 std::string format_refine_report(const RefineReport& report);

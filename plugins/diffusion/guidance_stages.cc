@@ -4,8 +4,6 @@
 #include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/contact_support.h"
 #include "core/features/contact_map.h"
-#include "core/metrics/articulation.h"
-#include "core/metrics/contact.h"
 #include "core/pipeline/plugin.h"
 #include "stages/guidance.h"
 
@@ -31,10 +29,14 @@ class ContactMapGuidanceStage : public GuidanceStage {
         .param("hold", false,
                "frames where the object moves (the hinge turns) with no hand's map touching it (its top part): "
                "the nearest hand is read as touching where its map is smallest (ours; core/diffusion/contact_support.h)")
+        .param("hold_place", false,
+               "with the placement: where the object moves (the hinge turns) and no hand's keypoints come within "
+               "place_threshold of it (its top part), the nearest hand is moved onto it (ours; core/diffusion/contact_support.h)")
         .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
   }
   explicit ContactMapGuidanceStage(const Params& p)
-      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))), hold_(p.boolean("hold")) {
+      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))), hold_(p.boolean("hold")),
+        hold_place_(p.boolean("hold_place")) {
     if (!(scale_ >= 0)) throw Error("'scale' must not be negative");
     if (place_steps_ < 0) throw Error("'place_steps' must not be negative");
     place_.threshold = p.number("place_threshold");
@@ -51,19 +53,19 @@ class ContactMapGuidanceStage : public GuidanceStage {
     const at::Tensor points = basis_hit_points(object, states, hits);
     at::Tensor target = io.has("contact_maps_samples") ? io.in<at::Tensor>("contact_maps_samples")
                                                        : io.in<at::Tensor>("contact_maps").unsqueeze(0);
-    if (hold_)
-      target = diffusion::hold_contacts(target, diffusion::around_motion(object_moving_frames(object, states)),
-                                        diffusion::around_motion(angle_changing_frames(states)),
-                                        hits < static_cast<std::int64_t>(object.top.num_vertices()), place_.threshold);
+    const auto [held, turning] = held_frames(object, states);
+    const at::Tensor top = hits < static_cast<std::int64_t>(object.top.num_vertices());
+    if (hold_) target = diffusion::hold_contacts(target, held, turning, top, place_.threshold);
     auto g = std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_);
     g->set_placement(place_steps_, place_);
+    if (hold_place_) g->set_support(held, turning, top, place_.threshold);
     io.out("guidance", std::shared_ptr<const Guidance>(std::move(g)));
   }
 
  private:
   double scale_;
   int place_steps_;
-  bool hold_;
+  bool hold_, hold_place_;
   diffusion::PlacementOptions place_;
 };
 

@@ -3,6 +3,7 @@
 // Ceres with CGAL surface queries (core/refine/refinement.h). Starts from the previous
 // refiner's hand_params (refine.mano_fit); without one it fits first, with defaults.
 #include "core/features/hand_features.h"
+#include "core/metrics/held_frames.h"
 #include "core/object/object_distance.h"
 #include "core/pipeline/plugin.h"
 #include "core/refine/mano_fit.h"
@@ -32,7 +33,10 @@ class CeresRefineStage : public Refiner {
             .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
             .param("pen_growth", d.pen_growth, "factor of that growth per round")
             .param("accel_vertices", d.accel_vertices, "hand vertices in the acceleration term (>= 32)")
-            .param("threads", d.threads, "0: all cores (one hand per thread)");
+            .param("threads", d.threads, "0: all cores (one hand per thread)")
+            .param("w_hold", d.w_hold,
+                   "where the object moves (the hinge turns) and no hand touches it (its top part), the nearer hand "
+                   "is pulled onto it (ours; 0 = off, the paper's)");
     refine_plugin::declare_hand_params(s);
     return s;
   }
@@ -50,12 +54,15 @@ class CeresRefineStage : public Refiner {
     o_.pen_growth = p.number("pen_growth");
     o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));
     o_.threads = static_cast<int>(p.integer("threads"));
+    o_.w_hold = p.number("w_hold");
     o_.validate();
   }
 
   void run(StageIO& io) override {
     const at::Tensor& states = io.in<at::Tensor>("object_states");
-    const ObjectDistance distance(io.in<ArticulatedObject>("object"));  // built once, shared by the samples
+    const auto& object = io.in<ArticulatedObject>("object");
+    const ObjectDistance distance(object);  // built once, shared by the samples
+    const HeldFrames held = o_.w_hold > 0 ? held_frames(object, states) : HeldFrames{};
     const auto models = hands_->pointers();
     refine_plugin::refine_samples(io, o_.threads, [&](std::size_t k, const at::Tensor& X, const HandMotion* given, int threads) {
       HandMotion start;
@@ -70,7 +77,7 @@ class CeresRefineStage : public Refiner {
       RefineOptions o = o_;
       o.threads = threads;
       RefineReport report;
-      HandMotion motion = refine_hands(models, distance, states, X, start, o, &report);
+      HandMotion motion = refine_hands(models, distance, states, X, start, o, &report, held);
       log::info("refine.ceres: {} frames in {:.2f} s (sample {})\n{}", X.size(0), report.seconds, k,
                 format_refine_report(report));
       return motion;

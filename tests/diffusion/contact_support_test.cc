@@ -50,10 +50,79 @@ TEST(ContactSupport, AroundMotionHoldsBothEndsOfAStep) {
   EXPECT_EQ(around_motion({}), std::vector<bool>{});
 }
 
+// Support placement: keypoints [1, 3, 2, 6, 3] and four object points on the x axis (points
+// 0 and 1 on the top part, at x = 0 and 0.1; points 2 and 3 at x = 0.5, 0.6). Each hand is a
+// row of five keypoints at one height (y) over its point plus one stray keypoint 3.5 cm
+// below them: the left hand at 6 cm over point 1, the right at 4 cm over point 3.
+struct SupportExample {
+  at::Tensor H = at::zeros({1, 3, 2, 6, 3}, at::kFloat);
+  at::Tensor P = at::zeros({3, 4, 3}, at::kFloat);
+  explicit SupportExample(float stray_drop = 0.035f) {
+    for (int t = 0; t < 3; ++t) {
+      P[t].select(1, 0) = at::tensor({0.0f, 0.1f, 0.5f, 0.6f});
+      const float x[2] = {0.1f, 0.6f}, y[2] = {0.06f, 0.04f};
+      for (int h = 0; h < 2; ++h) {
+        for (int j = 0; j < 5; ++j) H[0][t][h][j] = at::tensor({x[h], y[h], 0.001f * static_cast<float>(j)});
+        H[0][t][h][5] = at::tensor({x[h], y[h] - stray_drop, 0.0f});
+      }
+    }
+  }
+};
+
+TEST(ContactSupport, SupportMovesTheNearestHandOntoTheObjectInHeldFramesOnly) {
+  const SupportExample e;
+  // sigma 0: no smoothing, so each frame's move is exact.
+  const at::Tensor d = support_translations(e.H, e.P, {true, false, true}, {false, false, false}, top_points(), 0.01, 0);
+  ASSERT_EQ(d.sizes(), (at::IntArrayRef{1, 3, 2, 3}));
+  // Held frames: the right hand (4 cm against 6) comes down onto point 3: its row of
+  // keypoints moves 4 cm down (the stray keypoint, 5 mm from the object, does not count as
+  // touching and ends inside); the left hand stays.
+  for (int t : {0, 2}) {
+    EXPECT_NEAR(d[0][t][1][1].item<float>(), -0.04f, 1e-6) << "frame " << t;
+    EXPECT_NEAR(d[0][t][1][0].item<float>(), 0.0f, 1e-6) << "frame " << t;
+    EXPECT_TRUE(at::equal(d[0][t][0], at::zeros({3})));
+  }
+  EXPECT_TRUE(at::equal(d[0][1], at::zeros({2, 3})));
+}
+
+TEST(ContactSupport, SupportPutsAHandOnTheTopPartWhereTheHingeTurns) {
+  const SupportExample e;
+  const at::Tensor d = support_translations(e.H, e.P, {false, false, false}, {false, true, false}, top_points(), 0.01, 0);
+  // Frame 1: nobody on the top part; the left hand is nearest to it (6 cm above point 1).
+  EXPECT_NEAR(d[0][1][0][1].item<float>(), -0.06f, 1e-6);
+  EXPECT_NEAR(d[0][1][0][0].item<float>(), 0.0f, 1e-6);
+  EXPECT_TRUE(at::equal(d[0][1][1], at::zeros({3})));
+  // A hand that already touches is left alone: the left hand's row 5 mm above point 1.
+  SupportExample near;
+  near.H.select(4, 1) -= 0.055;
+  const at::Tensor none = support_translations(near.H, near.P, {true, true, true}, {true, true, true}, top_points(), 0.01, 0);
+  EXPECT_TRUE(at::equal(none, at::zeros_like(none)));
+}
+
+TEST(ContactSupport, SmoothedSupportStillReachesInsideAStretch) {
+  // Five held frames in a row (sigma 2): the rounds make up what the smoothing takes, so
+  // every frame ends with the hand's row of keypoints within reach of the object.
+  SupportExample e(0.0f);
+  at::Tensor H = e.H.repeat({1, 2, 1, 1, 1}).slice(1, 0, 5).contiguous();
+  at::Tensor P = e.P.repeat({2, 1, 1}).slice(0, 0, 5).contiguous();
+  for (int t = 0; t < 5; ++t) H[0][t].select(2, 1) += 0.01f * static_cast<float>(t);  // rising away
+  const at::Tensor top = top_points()[0].expand({5, 4});
+  const at::Tensor d = support_translations(H, P, std::vector<bool>(5, true), std::vector<bool>(5, false), top, 0.01, 2.0);
+  const at::Tensor moved = H + d.unsqueeze(3);
+  for (int t = 0; t < 5; ++t) {
+    const float gap = (moved[0][t][1][0] - P[t][3]).norm().item<float>();  // the row's first keypoint
+    EXPECT_LT(gap, 0.01f) << "frame " << t;
+  }
+}
+
 TEST(ContactSupport, BadShapesAreErrors) {
   EXPECT_THROW(hold_contacts(at::zeros({3, 2, 4}), {true, true, true}, {true, true, true}, top_points(), 0.01), Error);
   EXPECT_THROW(hold_contacts(example_maps(), {true}, {true, true, true}, top_points(), 0.01), Error);
   EXPECT_THROW(hold_contacts(example_maps(), {true, true, true}, {true, true, true}, top_points(), 0), Error);
+  const SupportExample e;
+  EXPECT_THROW(support_translations(e.H, e.P, {true}, {true, true, true}, top_points(), 0.01, 2), Error);
+  EXPECT_THROW(support_translations(e.H[0], e.P, {true, true, true}, {true, true, true}, top_points(), 0.01, 2), Error);
+  EXPECT_THROW(support_translations(e.H, e.P, {true, true, true}, {true, true, true}, top_points(), 0, 2), Error);
 }
 
 }  // namespace

@@ -129,6 +129,39 @@ TEST(Refinement, PenetrationAlonePushesAHandOut) {
   }
 }
 
+// The hold term: hands predicted 3 cm above the slab (no projection term, which would also
+// bring them down). Where the object must be held, one hand comes onto it; elsewhere, and
+// with w_hold = 0, both stay up.
+TEST(Refinement, TheHoldTermPutsOneHandOnTheObjectWhereItMustBeHeld) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 4;
+  const PushedHands c = pushed_into_the_slab(object, N, -0.03f);
+  const HeldFrames held{{true, true, false, false}, {}};
+  RefineOptions o;
+  o.w_proj = 0;
+  const auto deepest = [&](const HandMotion& m, int h, int t) {
+    const at::Tensor v = m.vertices[h][t].to(at::kDouble).contiguous();
+    return distance.max_signed_distance(ObjectState{}, Eigen::Map<const Points3>(v.data_ptr<double>(), v.size(0), 3));
+  };
+  const HandMotion off = refine_hands(models, distance, c.states, c.pushed, c.fit, o, nullptr, held);
+  for (int t = 0; t < N; ++t)
+    for (int h = 0; h < 2; ++h) EXPECT_LT(deepest(off, h, t), -0.02) << "w_hold 0: hand " << h << ", frame " << t;
+  o.w_hold = 1e5;
+  RefineReport report;
+  const HandMotion on = refine_hands(models, distance, c.states, c.pushed, c.fit, o, &report, held);
+  std::printf("%s", format_refine_report(report).c_str());
+  EXPECT_EQ(report.hands[0].held_frames + report.hands[1].held_frames, 2);
+  for (int t = 0; t < 2; ++t) {
+    const double a = deepest(on, 0, t), b = deepest(on, 1, t);
+    EXPECT_GT(std::max(a, b), -0.005) << "frame " << t << ": a hand touches (Con's test)";
+    EXPECT_LE(std::max(a, b), o.pen_tolerance) << "frame " << t;
+    EXPECT_LT(std::min(a, b), -0.02) << "frame " << t << ": only one hand is held";
+  }
+  EXPECT_THROW(refine_hands(models, distance, c.states, c.pushed, c.fit, o, nullptr, HeldFrames{{true}, {}}), Error);
+}
+
 TEST(Refinement, AJitterySequenceComesOutSmoother) {
   const auto& models = test::shipped_hands();
   const ArticulatedObject object = slab();
