@@ -6,7 +6,6 @@
 #include <limits>
 #include <string>
 
-#include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/contact_placement.h"
 #include "core/util/error.h"
 

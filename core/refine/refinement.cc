@@ -149,6 +149,12 @@ inline void write_row(const double* src, double scale, const std::vector<Block>&
   }
 }
 
+// n · (d position of subset vertex s / dx): the row of a point-to-plane residual.
+inline void normal_row(const FrameTerms& f, int s, const Eigen::Vector3d& n, double* dst) {
+  const double *a = jac_row(f, s, 0), *b = jac_row(f, s, 1), *c = jac_row(f, s, 2);
+  for (int i = 0; i < kX; ++i) dst[i] = n.x() * a[i] + n.y() * b[i] + n.z() * c[i];
+}
+
 // Fit, projection and penetration rows of one frame's vertices that share a finger mask;
 // reads the cache.
 class FrameCost : public ceres::CostFunction {
@@ -197,10 +203,6 @@ class FrameCost : public ceres::CostFunction {
   }
 
  private:
-  static void normal_row(const FrameTerms& f, int s, const Eigen::Vector3d& n, double* dst) {
-    const double *a = jac_row(f, s, 0), *b = jac_row(f, s, 1), *c = jac_row(f, s, 2);
-    for (int i = 0; i < kX; ++i) dst[i] = n.x() * a[i] + n.y() * b[i] + n.z() * c[i];
-  }
   const HandData* d_;
   int64_t t_;
   std::vector<Block> blocks_;
@@ -256,9 +258,7 @@ class HoldCost : public ceres::CostFunction {
     r[0] = out > 0 ? d_->s_hold * out : 0.0;
     if (J) {
       double row[kX];
-      const double *a = jac_row(f, k, 0), *b = jac_row(f, k, 1), *c = jac_row(f, k, 2);
-      const Eigen::Vector3d& n = f.hold.normal;
-      for (int i = 0; i < kX; ++i) row[i] = n.x() * a[i] + n.y() * b[i] + n.z() * c[i];
+      normal_row(f, k, f.hold.normal, row);
       write_row(row, out > 0 ? d_->s_hold : 0.0, blocks_, 0, J);
     }
     return true;
@@ -494,7 +494,8 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
 
 // Per hand and frame, the part it is held to (HandData::hold_part): in a held (turning)
 // frame, the starting hand nearer the object (its top part); the term only pulls a hand
-// from outside, so one that touches or is inside costs nothing. The top part wins over the whole object for a hand chosen twice.
+// from outside, so one that touches or is inside costs nothing. The top part wins over the
+// whole object for a hand chosen twice.
 void assign_holds(const std::array<const HandModel*, 2>& models, const ObjectDistance& dist,
                   const std::vector<ObjectState>& states, const HandMotion& start, const HeldFrames& held,
                   const RefineOptions& o, std::array<HandData, 2>* data) {
