@@ -34,6 +34,11 @@ void ContactMapGuidance::set_placement(int steps, const PlacementOptions& option
   placement_ = options;
 }
 
+void ContactMapGuidance::set_release(int steps) {
+  if (steps < 0) throw Error("contact-map guidance: release steps must be >= 0");
+  release_steps_ = steps;
+}
+
 void ContactMapGuidance::set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach) {
   const auto N = points_.size(0);
   if (static_cast<std::int64_t>(held.size()) != N || static_cast<std::int64_t>(turning.size()) != N ||
@@ -167,11 +172,11 @@ at::Tensor ContactMapGuidance::placement(const at::Tensor& x0, std::int64_t firs
   return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays
 }
 
-at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t first, int /*step*/,
+at::Tensor ContactMapGuidance::correction(const at::Tensor& x0, std::int64_t first, int step,
                                           int /*num_steps*/) const {
   check_window(x0, first);
   const auto B = x0.size(0), T = x0.size(1);
-  if (scale_ == 0.0) return at::zeros_like(x0);
+  if (scale_ == 0.0 || step < release_steps_) return at::zeros_like(x0);
   const at::Tensor H = keypoint_blocks(x0.slice(-1, 0, 600).reshape({B, T, 2, kHandKeypoints, 3}));
   const at::Tensor P = points_.slice(0, first, first + T).contiguous();  // [T, 1024, 3]
   const at::Tensor C = targets(first, T, B).contiguous();                 // [B, T, 2, 1024]

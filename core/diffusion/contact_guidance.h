@@ -35,6 +35,9 @@ class ContactMapGuidance : public Guidance {
   // (core/diffusion/contact_support.h, support_translations): `held` and `turning` per frame
   // (N each), `top` [N, 1024] bool (the point lies on the top part), `reach` m.
   void set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach);
+  // No gradient correction at the last `steps` diffusion steps (t < steps; 0 = every step,
+  // the paper's): the denoiser's last predictions re-form the hands the correction bent.
+  void set_release(int steps);
 
   at::Tensor correction(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
   at::Tensor placement(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
@@ -59,6 +62,7 @@ class ContactMapGuidance : public Guidance {
   std::vector<bool> held_, turning_;
   at::Tensor top_;  // [N, 1024] bool
   double reach_ = 0.01;
+  int release_steps_ = 0;
 };
 
 }  // namespace bimart::diffusion

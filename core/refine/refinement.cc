@@ -278,6 +278,41 @@ Points3 pose_all(const LbsSubset& all, const double* x, const double* beta) {
 
 Plane plane_of(const ObjectSurfaceQuery& q) { return Plane{q.closest, q.normal}; }
 
+// The direction from a frame's inside vertices to the rest of the hand (zero when the hand
+// is wholly inside or not inside at all): where the hand as a whole is, it can leave.
+Eigen::Vector3d exit_direction(const Points3& v, const std::vector<std::pair<int, ObjectSurfaceQuery>>& near) {
+  std::vector<bool> inside(static_cast<size_t>(v.rows()), false);
+  Eigen::Vector3d c_in = Eigen::Vector3d::Zero(), c_out = Eigen::Vector3d::Zero();
+  int n_in = 0;
+  for (const auto& [i, q] : near)
+    if (q.signed_distance > 0) inside[static_cast<size_t>(i)] = true, c_in += v.row(i).transpose(), ++n_in;
+  const int n_out = static_cast<int>(v.rows()) - n_in;
+  if (n_in == 0 || n_out == 0) return Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < v.rows(); ++i)
+    if (!inside[static_cast<size_t>(i)]) c_out += v.row(i).transpose();
+  const Eigen::Vector3d e = c_out / n_out - c_in / n_in;
+  return e.norm() > 1e-9 ? Eigen::Vector3d(e.normalized()) : Eigen::Vector3d::Zero();
+}
+
+// The plane where a ray from inside point p along unit e leaves the object: sphere tracing
+// (a step of the signed distance never crosses the surface), then the surface there; its
+// normal is turned to face along e. Without an exit within reach, e's plane at the last point.
+Plane exit_plane(const ObjectDistance& dist, const ObjectState& st, Eigen::Vector3d p, const Eigen::Vector3d& e) {
+  constexpr double kReach = 0.06, kClose = 2e-4;  // m
+  double travelled = 0;
+  for (int step = 0; step < 32 && travelled < kReach; ++step) {
+    const ObjectSurfaceQuery q = dist.query(st, p);
+    if (q.signed_distance < kClose) {
+      const Eigen::Vector3d n = q.normal.dot(e) > 0 ? q.normal : e;
+      return Plane{q.closest, n};
+    }
+    const double stride = std::max(q.signed_distance, kClose);
+    p += stride * e;
+    travelled += stride;
+  }
+  return Plane{p, e};
+}
+
 struct Evaluation {
   RefineTerms terms;
   double max_depth = 0;
@@ -364,9 +399,14 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     double& boost = d->pen_boost[static_cast<size_t>(t)];
     if (grow && frame_depth > o.pen_tolerance) boost *= o.pen_growth;
     e.max_boost = std::max(e.max_boost, boost);
+    // A deep frame's inside vertices leave towards the hand's outside (exit_direction),
+    // not each to its nearest surface: in a part thinner than twice their depth the
+    // nearest side flips between vertices and rounds, and the hand stays stuck in it.
+    const Eigen::Vector3d exit = frame_depth > o.pen_exit_depth ? exit_direction(v, near) : Eigen::Vector3d::Zero();
     for (const auto& [i, q] : near) {
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
-      f->pen.push_back(plane_of(q));
+      const bool turn = q.signed_distance > 0 && !exit.isZero() && q.normal.dot(exit) < 0;
+      f->pen.push_back(turn ? exit_plane(dist, st, v.row(i).transpose(), exit) : plane_of(q));
       f->pen_scale.push_back(d->s_pen * boost);
     }
     f->sub = LbsSubset::from(*d->model, ids);
@@ -541,6 +581,7 @@ void RefineOptions::validate() const {
   nonneg(w_fit, "w_fit");
   nonneg(w_hold, "w_hold");
   nonneg(pen_margin, "pen_margin");
+  if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; infinity = off)");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
   if (max_outer_iterations < 0) throw Error("refinement: max_outer_iterations must be >= 0");
   nonneg(pen_tolerance, "pen_tolerance");

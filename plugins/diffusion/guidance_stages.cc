@@ -17,6 +17,8 @@ class ContactMapGuidanceStage : public GuidanceStage {
     return StageSpec::of<GuidanceStage>("contact_map",
                                         "pulls the keypoints' contact map onto C at every diffusion step")
         .param("scale", 1.0, "norm of the correction per sample (λ_c = scale / ||∇||); 0 = off")
+        .param("release_steps", 0,
+               "no correction at the last this many steps, so the denoiser re-forms the hands (ours; 0 = the paper's)")
         .param("place_steps", 0,
                "also translate each hand onto its contacts at the last this many steps (ours; 0 = the paper's)")
         .param("place_threshold", d.threshold, "m: object points with C below this are contacts (placement)")
@@ -35,10 +37,12 @@ class ContactMapGuidanceStage : public GuidanceStage {
         .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
   }
   explicit ContactMapGuidanceStage(const Params& p)
-      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))), hold_(p.boolean("hold")),
+      : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))),
+        release_steps_(static_cast<int>(p.integer("release_steps"))), hold_(p.boolean("hold")),
         hold_place_(p.boolean("hold_place")) {
     if (!(scale_ >= 0)) throw Error("'scale' must not be negative");
     if (place_steps_ < 0) throw Error("'place_steps' must not be negative");
+    if (release_steps_ < 0) throw Error("'release_steps' must not be negative");
     place_.threshold = p.number("place_threshold");
     place_.sigma = p.number("place_sigma");
     place_.iterations = static_cast<int>(p.integer("place_iterations"));
@@ -58,13 +62,14 @@ class ContactMapGuidanceStage : public GuidanceStage {
     if (hold_) target = diffusion::hold_contacts(target, held, turning, top, place_.threshold);
     auto g = std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_);
     g->set_placement(place_steps_, place_);
+    g->set_release(release_steps_);
     if (hold_place_) g->set_support(held, turning, top, place_.threshold);
     io.out("guidance", std::shared_ptr<const Guidance>(std::move(g)));
   }
 
  private:
   double scale_;
-  int place_steps_;
+  int place_steps_, release_steps_;
   bool hold_, hold_place_;
   diffusion::PlacementOptions place_;
 };

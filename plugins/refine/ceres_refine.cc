@@ -30,6 +30,8 @@ class CeresRefineStage : public Refiner {
             .param("steps", d.max_iterations, "solver steps per round")
             .param("max_rounds", d.max_outer_iterations, "rounds while a frame is deeper than pen_tolerance")
             .param("pen_margin", d.pen_margin, "m: vertices this close to the surface get a penetration plane")
+            .param("pen_exit_depth", d.pen_exit_depth,
+                   "m: frames deeper than this push inside vertices out towards the rest of the hand (1e9 = off)")
             .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
             .param("pen_growth", d.pen_growth, "factor of that growth per round")
             .param("accel_vertices", d.accel_vertices, "hand vertices in the acceleration term (>= 32)")
@@ -50,6 +52,7 @@ class CeresRefineStage : public Refiner {
     o_.max_iterations = static_cast<int>(p.integer("steps"));
     o_.max_outer_iterations = static_cast<int>(p.integer("max_rounds"));
     o_.pen_margin = p.number("pen_margin");
+    o_.pen_exit_depth = p.number("pen_exit_depth");
     o_.pen_tolerance = p.number("pen_tolerance");
     o_.pen_growth = p.number("pen_growth");
     o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));

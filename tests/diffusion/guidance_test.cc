@@ -71,5 +71,19 @@ TEST(ContactGuidance, LowersTheDiscrepancyOfAFixedExample) {
   EXPECT_THROW(g.correction(e.start, 1, 0, 50), std::exception);  // frames 1..9 of 8
 }
 
+TEST(ContactGuidance, ReleasedLastStepsTakeNoCorrection) {
+  const Example e = example(4);
+  const at::Tensor target = std::get<0>(ContactMapGuidance::keypoint_contact_map(
+      e.truth.slice(-1, 0, 600).reshape({1, 4, 2, 100, 3}), e.points))[0];
+  ContactMapGuidance g(e.points, target, 1.0);
+  const at::Tensor full = g.correction(e.start, 0, 2, 50);
+  g.set_release(3);
+  EXPECT_EQ(g.correction(e.start, 0, 2, 50).abs().max().item<double>(), 0.0);  // t = 2 < 3: released
+  EXPECT_EQ(g.correction(e.start, 0, 0, 50).abs().max().item<double>(), 0.0);
+  EXPECT_TRUE(at::equal(g.correction(e.start, 0, 3, 50), full));  // t = 3: guided as before
+  EXPECT_NEAR(full.slice(-1, 0, 600).norm().item<double>(), 1.0, 1e-5);
+  EXPECT_THROW(g.set_release(-1), std::exception);
+}
+
 }  // namespace
 }  // namespace bimart::diffusion

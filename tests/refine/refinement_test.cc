@@ -2,6 +2,8 @@
 // into a box comes out, a jittery sequence comes out smoother.
 #include "core/refine/refinement.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <ATen/ATen.h>
@@ -127,6 +129,33 @@ TEST(Refinement, PenetrationAlonePushesAHandOut) {
     EXPECT_GT(report.hands[h].max_depth_before, 0.006);
     EXPECT_LE(report.hands[h].max_depth_after, o.pen_tolerance);
   }
+}
+
+// A part thinner than twice the depth: hands predicted 1.5 cm into a 2 cm slab have their
+// deepest vertices nearer its underside. Pushed each to its nearest surface they split and
+// stay stuck; pushed towards the rest of the hand (pen_exit_depth) they all leave on top.
+TEST(Refinement, AHandSunkPastTheMiddleOfAThinPartLeavesOnItsOwnSide) {
+  const auto& models = test::shipped_hands();
+  ArticulatedObject object = slab();
+  object.bottom = shapes::rounded_box({-0.2, -0.2, -0.02}, {0.2, 0.2, 0.0}, 0.005, 0.01);
+  const ObjectDistance distance(object);
+  const PushedHands c = pushed_into_the_slab(object, 4, 0.015f);
+  RefineOptions exit, nearest;
+  exit.w_proj = nearest.w_proj = 0;  // penetration alone, as above
+  nearest.pen_exit_depth = std::numeric_limits<double>::infinity();
+  RefineReport with, without;
+  const HandMotion out = refine_hands(models, distance, c.states, c.pushed, c.fit, exit, &with);
+  refine_hands(models, distance, c.states, c.pushed, c.fit, nearest, &without);
+  std::printf("exit:\n%snearest:\n%s", format_refine_report(with).c_str(), format_refine_report(without).c_str());
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_GT(with.hands[h].max_depth_before, 0.008);  // the middle of the slab is 1 cm deep
+    EXPECT_LE(with.hands[h].max_depth_after, exit.pen_tolerance) << "hand " << h;
+    EXPECT_GT(without.hands[h].max_depth_after, 2 * exit.pen_tolerance) << "hand " << h;
+    // Out on top, where the hand came from, not through the underside.
+    EXPECT_GT(out.vertices[h].select(2, 2).mean().item<double>(), 0.0) << "hand " << h;
+  }
+  nearest.pen_exit_depth = -1;
+  EXPECT_THROW(nearest.validate(), Error);
 }
 
 // The hold term: hands predicted 3 cm above the slab (no projection term, which would also
