@@ -260,6 +260,9 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--w-fit", o.refine.w_fit, "refinement: keypoint weight")->capture_default_str();
   cmd->add_option("--w-hold", o.refine.w_hold, "refinement: hold weight (a hand on the object where it moves; 0 = off)")
       ->capture_default_str();
+  cmd->add_option("--pen-exit-depth", o.refine.pen_exit_depth,
+                  "refinement: frames deeper than this (m) push inside vertices out towards the rest of the hand (1e9 = off)")
+      ->capture_default_str();
   cmd->add_option("--rounds", o.refine.outer_iterations, "refinement: surface linearisations")->capture_default_str();
   cmd->add_option("--steps", o.refine.max_iterations, "refinement: solver steps per round")->capture_default_str();
   cmd->add_option("--noise", o.corruption.noise, "corruption: RMS keypoint error (m)")->capture_default_str();

@@ -581,7 +581,7 @@ void RefineOptions::validate() const {
   nonneg(w_fit, "w_fit");
   nonneg(w_hold, "w_hold");
   nonneg(pen_margin, "pen_margin");
-  if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; infinity = off)");
+  if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
   if (max_outer_iterations < 0) throw Error("refinement: max_outer_iterations must be >= 0");
   nonneg(pen_tolerance, "pen_tolerance");
