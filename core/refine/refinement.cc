@@ -281,16 +281,14 @@ Plane plane_of(const ObjectSurfaceQuery& q) { return Plane{q.closest, q.normal};
 // The direction from a frame's inside vertices to the rest of the hand (zero when the hand
 // is wholly inside or not inside at all): where the hand as a whole is, it can leave.
 Eigen::Vector3d exit_direction(const Points3& v, const std::vector<std::pair<int, ObjectSurfaceQuery>>& near) {
-  std::vector<bool> inside(static_cast<size_t>(v.rows()), false);
-  Eigen::Vector3d c_in = Eigen::Vector3d::Zero(), c_out = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum_in = Eigen::Vector3d::Zero();
   int n_in = 0;
   for (const auto& [i, q] : near)
-    if (q.signed_distance > 0) inside[static_cast<size_t>(i)] = true, c_in += v.row(i).transpose(), ++n_in;
+    if (q.signed_distance > 0) sum_in += v.row(i).transpose(), ++n_in;
   const int n_out = static_cast<int>(v.rows()) - n_in;
   if (n_in == 0 || n_out == 0) return Eigen::Vector3d::Zero();
-  for (Eigen::Index i = 0; i < v.rows(); ++i)
-    if (!inside[static_cast<size_t>(i)]) c_out += v.row(i).transpose();
-  const Eigen::Vector3d e = c_out / n_out - c_in / n_in;
+  const Eigen::Vector3d sum_out = v.colwise().sum().transpose() - sum_in;  // the rest of the hand
+  const Eigen::Vector3d e = sum_out / n_out - sum_in / n_in;
   return e.norm() > 1e-9 ? Eigen::Vector3d(e.normalized()) : Eigen::Vector3d::Zero();
 }
 

@@ -64,7 +64,7 @@ struct RefineOptions {
   double pen_margin = 0.005;   // m: vertices closer than this to the surface get a plane
   // m: in a frame whose deepest vertex is deeper than this, inside vertices whose nearest
   // surface faces away from the rest of the hand take the plane where they leave the object
-  // towards it (a thin part passed through; 0 = always, infinity = never: nearest surface)
+  // towards it (a thin part passed through; 0 = always, 1e9 = never: nearest surface)
   double pen_exit_depth = 0.005;
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
