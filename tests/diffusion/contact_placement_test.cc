@@ -93,8 +93,10 @@ TEST(ContactPlacement, FramesWithoutContactsStayAndTheTranslationFadesIntoThem) 
   EXPECT_NEAR(size[5].item<double>(), 0.02, 0.004);           // inside the contacts: placed
   EXPECT_LT(size[25].item<double>(), 1e-3);                   // 3 sigma after: nearly untouched
   EXPECT_LT(size[39].item<double>(), 1e-9);
-  EXPECT_LT(size[21].item<double>(), size[18].item<double>());  // fading, not a jump
-  EXPECT_GT(size[21].item<double>(), 1e-3);
+  // Fading, not a jump. Frame 21 still has Gaussian weight > 1 from frames < 20 (the
+  // normaliser's clamp), so it keeps the full step; frame 22 has ~0.52 of it.
+  EXPECT_LT(size[22].item<double>(), 0.75 * size[18].item<double>());
+  EXPECT_GT(size[22].item<double>(), 0.25 * size[18].item<double>());
 }
 
 TEST(ContactPlacement, SnapPlacesANearlyTouchingHandWhereItsMapIsSmallest) {
