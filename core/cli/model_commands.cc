@@ -71,7 +71,7 @@ int run_check(const CheckArgs& a) {
   const at::Tensor truth = motion ? b.hand_features : b.contact_maps.flatten(-2);  // metres
   const at::Tensor x0 = diffusion::normalized_sample(info.network.model, st, b);
   const auto to_metres = [&](const at::Tensor& z) {
-    return motion ? st.denormalize_x(z) : st.denormalize_c(z.view({z.size(0), z.size(1), 2, 1024})).flatten(-2);
+    return motion ? st.denormalize_x(z) : st.contact_from_sample(z).flatten(-2);
   };
   const auto metric = [&](const at::Tensor& pred_m) {  // mm: keypoint distance (H) or |ΔC|
     if (motion) return 1000.0 * point_error(pred_m.slice(2, 0, 600), truth.slice(2, 0, 600));

@@ -98,6 +98,13 @@ NpyArray npy_of(const at::Tensor& t) {
   return make_npy(d.data_ptr<double>(), {d.size(0)});
 }
 
+// Window starts of `train`, by sequence (windows() is ordered by sequence).
+std::vector<std::vector<std::int32_t>> windows_by_sequence(const WindowDataset& train) {
+  std::vector<std::vector<std::int32_t>> starts(train.sequences().size());
+  for (const WindowRef& r : train.windows()) starts[static_cast<std::size_t>(r.sequence)].push_back(r.start);
+  return starts;
+}
+
 at::Tensor read_vector(const NpzFile& f, const std::string& key, int64_t size, bool positive) {
   const std::vector<double> v = as_vector<double>(f.get(key, {size}), f.where(key));
   for (double x : v)
@@ -156,6 +163,61 @@ at::Tensor NormalizationStats::denormalize_c(const at::Tensor& c) const {
   return c_log_eps > 0 ? at::exp(v) - c_log_eps : v;
 }
 
+at::Tensor NormalizationStats::contact_sample(const at::Tensor& c) const {
+  const at::Tensor z = normalize_c(c);  // [..., 2, 1024]
+  if (!c_basis.defined()) return z.flatten(-2);
+  return at::matmul(z, c_basis.to(z.scalar_type())).flatten(-2);
+}
+
+std::int64_t NormalizationStats::contact_sample_size() const {
+  return c_basis.defined() ? 2 * c_basis.size(1) : 2 * kBasisRows;
+}
+
+at::Tensor NormalizationStats::contact_from_sample(const at::Tensor& z) const {
+  const std::int64_t D = contact_sample_size();
+  if (!z.defined() || z.dim() < 1 || z.size(-1) != D)
+    throw Error("contact_from_sample: need a contact sample [..., " + std::to_string(D) + "], got " + shape_str(z));
+  std::vector<std::int64_t> shape(z.sizes().begin(), z.sizes().end() - 1);
+  shape.push_back(2);
+  shape.push_back(D / 2);
+  at::Tensor v = z.reshape(shape);
+  if (c_basis.defined()) v = at::matmul(v, c_basis.to(z.scalar_type()).t());
+  return denormalize_c(v);
+}
+
+at::Tensor contact_basis(const WindowDataset& train, const NormalizationStats& stats, int k) {
+  if (k < 1 || k > kBasisRows)
+    throw Error("contact basis: the number of directions must be in [1, 1024], got " + std::to_string(k));
+  if (train.size() == 0) throw Error("contact basis: need at least one window");
+  at::NoGradGuard no_grad;
+  const auto& seqs = train.sequences();
+  const std::vector<std::vector<std::int32_t>> starts = windows_by_sequence(train);
+  const int w = train.window();
+  // principal_directions (core/diffusion/denoiser.h) does this for samples held in memory;
+  // a data set's maps (~1 GB) are accumulated instead. Σ_frames weight · z zᵀ over both
+  // hands' normalised maps z; their weighted mean is 0 per
+  // entry (the statistics' own weighting), so this is the covariance up to the total weight.
+  at::Tensor second = at::zeros({kBasisRows, kBasisRows}, at::kDouble);
+  double total = 0;
+  for (std::size_t i = 0; i < seqs.size(); ++i) {
+    const DatasetSequence& s = seqs[i];
+    std::vector<float> weight(static_cast<std::size_t>(s.frames), 0.0f);
+    for (std::int32_t start : starts[i])
+      for (int64_t f = start; f < std::min<int64_t>(start + w, s.frames); ++f) weight[static_cast<std::size_t>(f)] += 1;
+    const at::Tensor wt = at::tensor(weight, at::kFloat).repeat_interleave(2);  // [frames · 2]
+    const at::Tensor z =
+        stats.normalize_c(s.contact_maps.to(at::kFloat).reshape({s.frames, 2, kBasisRows})).reshape({-1, kBasisRows});
+    second += at::mm((z * wt.unsqueeze(1)).t(), z).to(at::kDouble);
+    total += wt.sum().item<double>();
+  }
+  if (!(total > 0)) throw Error("contact basis: the windows hold no frames");
+  const auto eig = at::linalg_eigh(second / total);                  // ascending eigenvalues
+  at::Tensor basis = std::get<1>(eig).flip({1}).slice(1, 0, k).contiguous();  // decreasing variance
+  const at::Tensor big = basis.abs().argmax(0, true);                          // [1, k]
+  basis = basis * basis.gather(0, big).sign();                                 // largest entry positive
+  return basis.contiguous();
+}
+
 NormalizationStats compute_normalization(const WindowDataset& train, double std_floor, double c_log_eps) {
   if (train.size() == 0) throw Error("normalisation statistics need at least one window");
   if (!(c_log_eps >= 0) || !std::isfinite(c_log_eps))
@@ -167,9 +229,7 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
   const int64_t n = static_cast<int64_t>(seqs.size());
   const int w = train.window();
 
-  // Windows by sequence (windows() is ordered by sequence).
-  std::vector<std::vector<std::int32_t>> starts(seqs.size());
-  for (const WindowRef& r : train.windows()) starts[static_cast<std::size_t>(r.sequence)].push_back(r.start);
+  const std::vector<std::vector<std::int32_t>> starts = windows_by_sequence(train);
 
   struct Partial {
     Moments x, o, c, g;
@@ -251,6 +311,12 @@ void store_normalization(const NormalizationStats& stats, NpzFile& f, const std:
   f.set(prefix + "obj_std", npy_of(stats.obj_std));
   f.set(prefix + "c_mean", npy_of(stats.c_mean));
   f.set(prefix + "c_std", npy_of(stats.c_std));
+  if (stats.c_basis.defined()) {
+    const at::Tensor b = stats.c_basis.to(at::kDouble).contiguous();
+    if (b.dim() != 2 || b.size(0) != kBasisRows || b.size(1) < 1 || b.size(1) > kBasisRows)
+      throw Error("normalisation statistics have a contact basis of shape " + shape_str(b) + ", expected [1024, K]");
+    f.set(prefix + "c_basis", make_npy(b.data_ptr<double>(), {b.size(0), b.size(1)}));
+  }
 }
 
 NormalizationStats read_normalization(const NpzFile& f, const std::string& prefix) {
@@ -278,6 +344,15 @@ NormalizationStats read_normalization(const NpzFile& f, const std::string& prefi
   st.obj_std = read_vector(f, prefix + "obj_std", kObjectConditionSize, true);
   st.c_mean = read_vector(f, prefix + "c_mean", 2 * kBasisRows, false);
   st.c_std = read_vector(f, prefix + "c_std", 2 * kBasisRows, true);
+  if (f.contains(prefix + "c_basis")) {
+    const std::string key = prefix + "c_basis";
+    const NpyArray& a = f.get(key, {kBasisRows, -1});
+    if (a.shape[1] < 1 || a.shape[1] > kBasisRows) throw Error(f.where(key) + " must have 1 to 1024 columns");
+    const std::vector<double> v = as_vector<double>(a, f.where(key));
+    for (double x : v)
+      if (!std::isfinite(x)) throw Error(f.where(key) + ": holds " + std::to_string(x) + " (not finite)");
+    st.c_basis = at::tensor(v, at::kDouble).view({kBasisRows, a.shape[1]});
+  }
   return st;
 }
 

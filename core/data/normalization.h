@@ -39,6 +39,12 @@ struct NormalizationStats {
   // contact model's sample, so that the few centimetres that decide contact are not lost
   // beside distances of 30 cm); 0: z = (C − c_mean) / c_std.
   double c_log_eps = 0;
+  // Defined: the contact model's sample is the normalised maps projected, per hand, onto
+  // these K orthonormal directions [1024, K] (float64, the principal directions of the
+  // training maps, contact_basis()): 2K numbers per frame instead of 2048, so that a narrow
+  // network can carry its noisy input (docs/training.md, "Contact basis"). Undefined: the
+  // 2048 normalised values.
+  at::Tensor c_basis;
 
   // X [..., 1200] -> normalised, same shape and dtype; and back.
   at::Tensor normalize_x(const at::Tensor& x) const;
@@ -48,6 +54,11 @@ struct NormalizationStats {
   // C [..., 2, 1024] -> normalised (in log space when c_log_eps > 0), same shape; and back.
   at::Tensor normalize_c(const at::Tensor& c) const;
   at::Tensor denormalize_c(const at::Tensor& c) const;
+  // The contact model's sample: C [..., 2, 1024] (metres) -> [..., contact_sample_size()],
+  // normalised and (with c_basis) projected; and back to metres [..., 2, 1024] (not clamped).
+  at::Tensor contact_sample(const at::Tensor& c) const;
+  at::Tensor contact_from_sample(const at::Tensor& z) const;
+  std::int64_t contact_sample_size() const;
 };
 
 // Over all windows of `train` (which should hold the train split). Throws when it is empty.
@@ -55,8 +66,15 @@ struct NormalizationStats {
 NormalizationStats compute_normalization(const WindowDataset& train, double std_floor = kNormalizationStdFloor,
                                          double c_log_eps = 0);
 
+// The first k principal directions [1024, k] (float64, by decreasing variance, each with
+// its largest entry positive) of `stats`' normalised contact maps over `train`'s windows,
+// the two hands pooled, frames weighted as compute_normalization weights them. Throws for
+// k outside [1, 1024].
+at::Tensor contact_basis(const WindowDataset& train, const NormalizationStats& stats, int k);
+
 // .npz with keys x_mean, x_std, obj_mean, obj_std, c_mean, c_std (f8), variant (string),
-// count (i8), std_floor (f8), format_version (i8); written atomically.
+// count (i8), std_floor (f8), format_version (i8), and c_log_eps (f8) and c_basis (f8
+// [1024, K]) when set; written atomically.
 void save_normalization(const NormalizationStats& stats, const std::string& path);
 // Throws bimart::Error naming the file and key on a missing key, a wrong shape or a
 // standard deviation that is not positive and finite.

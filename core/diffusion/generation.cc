@@ -32,6 +32,11 @@ DiffusionModel::DiffusionModel(Checkpoint checkpoint, std::string path)
     : checkpoint_(std::move(checkpoint)), path_(std::move(path)),
       schedule_(make_schedule(checkpoint_.info.schedule, checkpoint_.info.diffusion_steps)) {
   net_ = make_denoiser(checkpoint_, path_);
+  const ModelInfo& i = checkpoint_.info;
+  if (i.network.model == "contact" && i.network.sample_size != i.normalization.contact_sample_size())
+    throw Error(path_ + ": the contact model samples " + std::to_string(i.network.sample_size) +
+                " numbers per frame, but its statistics' contact basis gives " +
+                std::to_string(i.normalization.contact_sample_size()));
 }
 
 std::vector<std::pair<std::int64_t, std::int64_t>> DiffusionModel::windows(std::int64_t frames, int window,
@@ -192,7 +197,7 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));
   const StepHook hook = [&](int, int, at::Tensor& x) { x = agree(x); };
   const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, hook));
-  if (!motion) return st.denormalize_c(result.view({S, N, 2, 1024})).clamp_min(0.0);
+  if (!motion) return st.contact_from_sample(result).clamp_min(0.0);
   return st.denormalize_x(result);
 }
 

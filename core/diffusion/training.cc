@@ -212,7 +212,8 @@ TrainConfig load_train_config(const std::string& path) {
   if (const YAML::Node n = root["network"]) {
     check_keys(path, n, "network",
                {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank",
-                "contact_cue", "contact_points", "point_hidden", "contact_log_eps"});
+                "contact_cue", "contact_points", "point_hidden", "contact_log_eps",
+                "contact_basis"});
     read(path, n, "latent", c.network.latent);
     read(path, n, "layers", c.network.layers);
     read(path, n, "heads", c.network.heads);
@@ -225,6 +226,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "contact_points", c.network.contact_points);
     read(path, n, "point_hidden", c.network.point_hidden);
     read(path, n, "contact_log_eps", c.contact_log_eps);
+    read(path, n, "contact_basis", c.contact_basis);
   }
   if (const YAML::Node n = root["diffusion"]) {
     check_keys(path, n, "diffusion", {"schedule", "steps"});
@@ -252,6 +254,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "log_every", c.log_every);
   }
   set_sizes(c.network, c.model);
+  if (c.model == "contact" && c.contact_basis > 0) c.network.sample_size = 2 * c.contact_basis;
   try {
     validate(c);
   } catch (const Error& e) {
@@ -271,6 +274,11 @@ void validate(const TrainConfig& c) {
   need(c.stride >= 1, "'stride' must be positive");
   need(c.contact_log_eps >= 0 && std::isfinite(c.contact_log_eps), "'network.contact_log_eps' must be >= 0 (metres)");
   need(c.contact_log_eps == 0 || c.model == "contact", "'network.contact_log_eps' is for the contact model only");
+  need(c.contact_basis >= 0 && c.contact_basis <= kBasisRows, "'network.contact_basis' must be 0 (off) to 1024");
+  need(c.contact_basis == 0 || c.model == "contact", "'network.contact_basis' is for the contact model only");
+  if (c.model == "contact")
+    need(c.network.sample_size == (c.contact_basis > 0 ? 2 * c.contact_basis : 2 * kBasisRows),
+         "the contact model's sample size must be 2 x 'network.contact_basis' (or 2048 without a basis)");
   c.network.validate();
   make_schedule(c.schedule, c.diffusion_steps);
   need(c.batch >= 1 && c.batch <= 100000, "'training.batch' must be in [1, 100000]");
@@ -300,7 +308,7 @@ double learning_rate(const TrainConfig& c, std::int64_t step) {
 // ---- one step ----
 
 at::Tensor normalized_sample(const std::string& model, const NormalizationStats& stats, const WindowBatch& b) {
-  return model == "contact" ? stats.normalize_c(b.contact_maps).flatten(-2) : stats.normalize_x(b.hand_features);
+  return model == "contact" ? stats.contact_sample(b.contact_maps) : stats.normalize_x(b.hand_features);
 }
 
 StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b,
@@ -445,7 +453,8 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     test_set = std::make_unique<WindowDataset>(WindowDataset::open(config.data, "test", wo));
   bar.reset();
   if (train_set.size() == 0) throw Error(config.data + ": the train split has no windows");
-  const NormalizationStats stats = compute_normalization(train_set, kNormalizationStdFloor, config.contact_log_eps);
+  NormalizationStats stats = compute_normalization(train_set, kNormalizationStdFloor, config.contact_log_eps);
+  if (config.contact_basis > 0) stats.c_basis = contact_basis(train_set, stats, config.contact_basis);
   const NoiseSchedule schedule = make_schedule(config.schedule, config.diffusion_steps);
 
   ModelInfo info;

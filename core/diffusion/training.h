@@ -44,6 +44,9 @@ struct TrainConfig {
   // Contact model: > 0 samples C in log space, log(C + contact_log_eps) normalised (metres;
   // NormalizationStats::c_log_eps). 0: C itself (the paper's).
   double contact_log_eps = 0;
+  // Contact model: > 0 samples C in the K principal directions per hand of the normalised
+  // training maps (NormalizationStats::c_basis; a sample of 2K per frame). 0: all 2048.
+  int contact_basis = 0;
   std::string schedule = "squaredcos_cap_v2";
   int diffusion_steps = 50;
   int batch = 64;          // windows per step (per process when distributed)

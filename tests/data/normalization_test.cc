@@ -121,6 +121,52 @@ TEST(Normalization, ContactMapsInLogSpace) {
   EXPECT_THROW(compute_normalization(ds, kNormalizationStdFloor, -1), Error);
 }
 
+TEST(Normalization, ContactBasisIsThePrincipalSubspaceOfTheNormalisedMaps) {
+  const WindowDataset& ds = tiny_train();
+  const NormalizationStats& st = train_stats();
+  const int k = 8;
+  const at::Tensor U = contact_basis(ds, st, k);  // [1024, k]
+  ASSERT_EQ(U.sizes(), (at::IntArrayRef{1024, k}));
+  EXPECT_TRUE(at::allclose(at::mm(U.t(), U), at::eye(k, at::kDouble), 0, 1e-9));  // orthonormal
+  // Cross-check with a direct eigen-decomposition of the windows' normalised maps, every
+  // (window, real frame, hand) one row: the same subspace (projectors agree).
+  const WindowBatch b = ds.batch(all_windows(ds));
+  const at::Tensor valid = b.mask.flatten().nonzero().squeeze(1);
+  const at::Tensor z = st.normalize_c(b.contact_maps).reshape({-1, 2, 1024}).index_select(0, valid).reshape({-1, 1024});
+  const at::Tensor zd = z.to(at::kDouble);
+  const at::Tensor V = std::get<1>(at::linalg_eigh(at::mm(zd.t(), zd))).flip({1}).slice(1, 0, k);
+  EXPECT_LT((at::mm(U, U.t()) - at::mm(V, V.t())).abs().max().item<double>(), 1e-6);
+  // It holds more of the maps' energy than any other k directions, e.g. the first k axes.
+  const double kept = at::mm(zd, U).pow(2).sum().item<double>(), axes = zd.slice(1, 0, k).pow(2).sum().item<double>();
+  EXPECT_GT(kept, axes);
+  EXPECT_GT(kept, 0.5 * zd.pow(2).sum().item<double>());
+
+  // The contact sample: 2k numbers per frame; maps in the subspace come back exactly.
+  NormalizationStats pst = st;
+  pst.c_basis = U;
+  EXPECT_EQ(pst.contact_sample_size(), 2 * k);
+  EXPECT_EQ(st.contact_sample_size(), 2048);
+  const at::Tensor coeff = at::randn({3, 2, k}, at::kDouble);
+  const at::Tensor inside = pst.denormalize_c(at::matmul(coeff, U.t()).to(at::kFloat));  // metres [3, 2, 1024]
+  const at::Tensor sample = pst.contact_sample(inside);
+  ASSERT_EQ(sample.sizes(), (at::IntArrayRef{3, 2 * k}));
+  EXPECT_LT((sample.view({3, 2, k}).to(at::kDouble) - coeff).abs().max().item<double>(), 1e-4);
+  EXPECT_LT((pst.contact_from_sample(sample) - inside).abs().max().item<double>(), 1e-5);
+  // Without a basis the sample is the 2048 normalised values.
+  EXPECT_TRUE(at::allclose(st.contact_sample(b.contact_maps), st.normalize_c(b.contact_maps).flatten(-2)));
+  EXPECT_THROW(pst.contact_from_sample(at::zeros({3, 2048})), Error);
+  EXPECT_THROW(contact_basis(ds, st, 0), Error);
+  EXPECT_THROW(contact_basis(ds, st, 1025), Error);
+
+  // Stored with the statistics; a basis of the wrong shape is refused.
+  const fs::path dir = tiny_dataset().dir / "stats_basis";
+  save_normalization(pst, (dir / "stats.npz").string());
+  EXPECT_TRUE(at::equal(load_normalization((dir / "stats.npz").string()).c_basis, U));
+  EXPECT_FALSE(load_normalization((dir / "stats.npz").string()).c_log_eps > 0);
+  pst.c_basis = at::zeros({1000, k}, at::kDouble);
+  EXPECT_THROW(save_normalization(pst, (dir / "bad.npz").string()), Error);
+}
+
 TEST(Normalization, StatisticsComeFromTheTrainSplitOnly) {
   WindowDatasetOptions o;
   o.cache = false;

@@ -15,6 +15,7 @@
 #include "core/data/normalization.h"
 #include "core/diffusion/checkpoint.h"
 #include "core/diffusion/distributed.h"
+#include "core/diffusion/generation.h"
 #include "core/diffusion/schedule.h"
 #include "core/diffusion/training.h"
 #include "core/util/error.h"
@@ -103,6 +104,46 @@ TEST(Training, ConfigFileErrorsNameTheLine) {
   EXPECT_THROW(load_train_config(bad.string()), Error);
   std::ofstream(bad) << "model: contact\ndata: d\nout: o\nnetwork:\n  contact_log_eps: -1\n";
   EXPECT_THROW(load_train_config(bad.string()), Error);
+  // The contact basis: 2K numbers per frame; the contact model's only, at most 1024.
+  std::ofstream(good) << "model: contact\ndata: d\nout: o\nnetwork:\n  contact_basis: 64\n";
+  EXPECT_EQ(load_train_config(good.string()).network.sample_size, 128);
+  std::ofstream(bad) << "model: motion\ndata: d\nout: o\nnetwork:\n  contact_basis: 64\n";
+  EXPECT_THROW(load_train_config(bad.string()), Error);
+  std::ofstream(bad) << "model: contact\ndata: d\nout: o\nnetwork:\n  contact_basis: 1025\n";
+  EXPECT_THROW(load_train_config(bad.string()), Error);
+}
+
+TEST(Training, ContactModelInABasisSamplesFullMapsFromItsSubspace) {
+  const fs::path dir = scratch("basis");
+  TrainConfig c = tiny_config(dir, "contact");
+  c.contact_basis = 4;
+  TrainOptions quiet;
+  quiet.progress = false;
+  EXPECT_THROW(train(c, quiet), Error);  // sample size still 2048
+  c.network.sample_size = 8;
+  EXPECT_TRUE(train(c, quiet).finished);
+  const Checkpoint ck = load_checkpoint((dir / "checkpoint.npz").string());
+  const NormalizationStats& st = ck.info.normalization;
+  ASSERT_TRUE(st.c_basis.defined());
+  ASSERT_EQ(st.c_basis.sizes(), (at::IntArrayRef{1024, 4}));
+  // Sampled maps are full [S, N, 2, 1024] maps in metres, from the 4-direction subspace
+  // (up to the clamp at 0): projecting and reconstructing them changes nothing.
+  const DiffusionModel model(ck, (dir / "checkpoint.npz").string());
+  GenerateOptions o;
+  o.sampler.sampler = "ddim";
+  o.sampler.steps = 3;
+  o.samples = 2;
+  const at::Tensor O = at::randn({10, 1024, 3}) * 0.1, G = at::zeros({10, 7});
+  const at::Tensor C = model.generate(O, G, {}, nullptr, o, at::detail::createCPUGenerator(3));
+  ASSERT_EQ(C.sizes(), (at::IntArrayRef{2, 10, 2, 1024}));
+  EXPECT_GE(C.min().item<double>(), 0.0);
+  const at::Tensor positive = C > 0;
+  const at::Tensor again = st.contact_from_sample(st.contact_sample(C));
+  EXPECT_LT((again - C).masked_select(positive).abs().max().item<double>(), 0.05 * C.abs().max().item<double>());
+  // A checkpoint whose network does not match its statistics' basis is refused.
+  Checkpoint broken = ck;
+  broken.info.normalization.c_basis = at::Tensor();
+  EXPECT_THROW(DiffusionModel(broken, "broken.npz"), Error);
 }
 
 TEST(Training, WarmStartFromAModelWithoutTheContactCueKeepsItsOutput) {
