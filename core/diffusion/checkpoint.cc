@@ -88,6 +88,7 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
     f.set(std::string("network/") + field.key, make_npy_scalar<std::int64_t>(i.network.*field.member));
   set_string(f, "diffusion/schedule", i.schedule);
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
+  if (i.schedule_shift != 1.0) f.set("diffusion/shift", make_npy_scalar<double>(i.schedule_shift));
   set_string(f, "encoder/variant", i.variant);
   if (!i.basis_points.defined()) throw Error(path + ": checkpoint without basis points");
   f.set("encoder/basis_points", npy_from_tensor(i.basis_points.to(at::kFloat)));
@@ -147,6 +148,7 @@ Checkpoint load_checkpoint(const std::string& path) {
   }
   i.schedule = get_string(f, "diffusion/schedule");
   i.diffusion_steps = static_cast<int>(get_int(f, "diffusion/steps"));
+  if (f.contains("diffusion/shift")) i.schedule_shift = f.vector<double>("diffusion/shift").at(0);
   i.variant = get_string(f, "encoder/variant");
   i.basis_points = tensor_from_npy(f.get("encoder/basis_points", {-1, 3}), f.where("encoder/basis_points"));
   i.keypoints = f.vector<std::int64_t>("hand/keypoints");

@@ -29,6 +29,7 @@ struct ModelInfo {
   DenoiserConfig network;
   std::string schedule = "squaredcos_cap_v2";
   int diffusion_steps = 50;
+  double schedule_shift = 1;       // make_schedule's shift (1 = none)
   std::string variant = "np_bps";  // encoder of O (bps_variant_name)
   at::Tensor basis_points;         // [1024, 3] float32, encoder space
   std::vector<std::int64_t> keypoints;  // J = 100 hand keypoint vertex ids

@@ -30,7 +30,7 @@ std::shared_ptr<const DiffusionModel> DiffusionModel::load(const std::string& pa
 
 DiffusionModel::DiffusionModel(Checkpoint checkpoint, std::string path)
     : checkpoint_(std::move(checkpoint)), path_(std::move(path)),
-      schedule_(make_schedule(checkpoint_.info.schedule, checkpoint_.info.diffusion_steps)) {
+      schedule_(make_schedule(checkpoint_.info.schedule, checkpoint_.info.diffusion_steps, checkpoint_.info.schedule_shift)) {
   net_ = make_denoiser(checkpoint_, path_);
   const ModelInfo& i = checkpoint_.info;
   if (i.network.model == "contact" && i.network.sample_size != i.normalization.contact_sample_size())

@@ -9,11 +9,13 @@
 
 namespace bimart::diffusion {
 
-NoiseSchedule make_schedule(const std::string& name, int steps) {
+NoiseSchedule make_schedule(const std::string& name, int steps, double shift) {
   if (steps < 1) throw Error("noise schedule: steps must be at least 1, got " + std::to_string(steps));
+  if (!(shift > 0 && shift <= 1)) throw Error("noise schedule: shift must be in (0, 1], got " + std::to_string(shift));
   NoiseSchedule s;
   s.name = name;
   s.steps = steps;
+  s.shift = shift;
   s.betas.resize(static_cast<std::size_t>(steps));
   if (name == "squaredcos_cap_v2") {
     const auto f = [&](double t) {
@@ -33,6 +35,16 @@ NoiseSchedule make_schedule(const std::string& name, int steps) {
   for (int t = 0; t < steps; ++t) {
     prod *= 1.0 - s.betas[t];
     s.alphas_cumprod[t] = prod;
+  }
+  if (shift != 1.0) {
+    const double s2 = shift * shift;
+    double prev = 1.0;
+    for (int t = 0; t < steps; ++t) {
+      const double a = s.alphas_cumprod[t];
+      s.alphas_cumprod[t] = a * s2 / (a * s2 + 1.0 - a);
+      s.betas[t] = 1.0 - s.alphas_cumprod[t] / prev;
+      prev = s.alphas_cumprod[t];
+    }
   }
   return s;
 }

@@ -229,8 +229,9 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "contact_basis", c.contact_basis);
   }
   if (const YAML::Node n = root["diffusion"]) {
-    check_keys(path, n, "diffusion", {"schedule", "steps"});
+    check_keys(path, n, "diffusion", {"schedule", "steps", "shift"});
     read(path, n, "schedule", c.schedule);
+    read(path, n, "shift", c.schedule_shift);
     read(path, n, "steps", c.diffusion_steps);
   }
   if (const YAML::Node n = root["training"]) {
@@ -280,7 +281,7 @@ void validate(const TrainConfig& c) {
     need(c.network.sample_size == (c.contact_basis > 0 ? 2 * c.contact_basis : 2 * kBasisRows),
          "the contact model's sample size must be 2 x 'network.contact_basis' (or 2048 without a basis)");
   c.network.validate();
-  make_schedule(c.schedule, c.diffusion_steps);
+  make_schedule(c.schedule, c.diffusion_steps, c.schedule_shift);
   need(c.batch >= 1 && c.batch <= 100000, "'training.batch' must be in [1, 100000]");
   need(c.steps >= 1, "'training.steps' must be positive");
   need(c.lr > 0 && c.lr < 1, "'training.lr' must be in (0, 1)");
@@ -455,12 +456,13 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   if (train_set.size() == 0) throw Error(config.data + ": the train split has no windows");
   NormalizationStats stats = compute_normalization(train_set, kNormalizationStdFloor, config.contact_log_eps);
   if (config.contact_basis > 0) stats.c_basis = contact_basis(train_set, stats, config.contact_basis);
-  const NoiseSchedule schedule = make_schedule(config.schedule, config.diffusion_steps);
+  const NoiseSchedule schedule = make_schedule(config.schedule, config.diffusion_steps, config.schedule_shift);
 
   ModelInfo info;
   info.network = config.network;
   info.schedule = config.schedule;
   info.diffusion_steps = config.diffusion_steps;
+  info.schedule_shift = config.schedule_shift;
   info.variant = config.variant;
   info.basis_points = train_set.basis_points();
   info.keypoints = posing_keypoint_ids();

@@ -48,6 +48,7 @@ struct TrainConfig {
   // training maps (NormalizationStats::c_basis; a sample of 2K per frame). 0: all 2048.
   int contact_basis = 0;
   std::string schedule = "squaredcos_cap_v2";
+  double schedule_shift = 1;  // diffusion.shift: make_schedule's data scale (1 = none)
   int diffusion_steps = 50;
   int batch = 64;          // windows per step (per process when distributed)
   std::int64_t steps = 10000;

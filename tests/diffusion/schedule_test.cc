@@ -47,6 +47,31 @@ TEST(Schedule, RejectsUnknownNamesAndSteps) {
   EXPECT_THROW(make_schedule("linear", 0), Error);
 }
 
+TEST(Schedule, ShiftScalesTheSignalToNoiseRatioByTheSquaredScale) {
+  const NoiseSchedule plain = make_schedule("squaredcos_cap_v2", 50);
+  const NoiseSchedule shifted = make_schedule("squaredcos_cap_v2", 50, 0.2);
+  EXPECT_DOUBLE_EQ(shifted.shift, 0.2);
+  double prod = 1.0;
+  for (int t = 0; t < 50; ++t) {
+    const double a = plain.alphas_cumprod[t], b = shifted.alphas_cumprod[t];
+    if (a < 1 - 1e-12 && a > 1e-12) EXPECT_NEAR((b / (1 - b)) / (a / (1 - a)), 0.04, 1e-9) << t;  // SNR × s²
+    EXPECT_LT(b, a + 1e-15);
+    prod *= 1.0 - shifted.betas[t];  // betas consistent with the new ᾱ
+    EXPECT_NEAR(prod, b, 1e-12) << t;
+  }
+  // Noising with the shifted schedule is noising the scaled data, up to a common factor:
+  // x_t' = (sqrt(ᾱ) s x0 + sqrt(1 − ᾱ) ε) / sqrt(ᾱ s² + 1 − ᾱ).
+  const int t = 20;
+  const double a = plain.alphas_cumprod[t];
+  const at::Tensor x0 = at::randn({2, 5}), eps = at::randn({2, 5}), tt = at::full({2}, t, at::kLong);
+  const at::Tensor direct = (std::sqrt(a) * 0.2 * x0 + std::sqrt(1 - a) * eps) / std::sqrt(a * 0.04 + 1 - a);
+  EXPECT_TRUE(at::allclose(add_noise(shifted, x0, eps, tt), direct, 1e-5, 1e-6));
+  EXPECT_EQ(make_schedule("squaredcos_cap_v2", 50, 1.0).alphas_cumprod, plain.alphas_cumprod);
+  EXPECT_THROW(make_schedule("squaredcos_cap_v2", 50, 0.0), Error);
+  EXPECT_THROW(make_schedule("squaredcos_cap_v2", 50, 1.5), Error);
+  EXPECT_THROW(make_schedule("squaredcos_cap_v2", 50, std::nan("")), Error);
+}
+
 TEST(Schedule, AddNoiseIsTheClosedForm) {
   const NoiseSchedule s = make_schedule("squaredcos_cap_v2", 50);
   const at::Tensor x0 = at::randn({3, 4, 5});

@@ -111,12 +111,18 @@ TEST(Training, ConfigFileErrorsNameTheLine) {
   EXPECT_THROW(load_train_config(bad.string()), Error);
   std::ofstream(bad) << "model: contact\ndata: d\nout: o\nnetwork:\n  contact_basis: 1025\n";
   EXPECT_THROW(load_train_config(bad.string()), Error);
+  // The schedule's shift, in (0, 1].
+  std::ofstream(good) << "model: motion\ndata: d\nout: o\ndiffusion:\n  shift: 0.25\n";
+  EXPECT_DOUBLE_EQ(load_train_config(good.string()).schedule_shift, 0.25);
+  std::ofstream(bad) << "model: motion\ndata: d\nout: o\ndiffusion:\n  shift: 2\n";
+  EXPECT_THROW(load_train_config(bad.string()), Error);
 }
 
 TEST(Training, ContactModelInABasisSamplesFullMapsFromItsSubspace) {
   const fs::path dir = scratch("basis");
   TrainConfig c = tiny_config(dir, "contact");
   c.contact_basis = 4;
+  c.schedule_shift = 0.5;  // stored with the model, used by its sampler
   TrainOptions quiet;
   quiet.progress = false;
   EXPECT_THROW(train(c, quiet), Error);  // sample size still 2048
@@ -129,6 +135,8 @@ TEST(Training, ContactModelInABasisSamplesFullMapsFromItsSubspace) {
   // Sampled maps are full [S, N, 2, 1024] maps in metres, from the 4-direction subspace
   // (up to the clamp at 0): projecting and reconstructing them changes nothing.
   const DiffusionModel model(ck, (dir / "checkpoint.npz").string());
+  EXPECT_DOUBLE_EQ(ck.info.schedule_shift, 0.5);
+  EXPECT_EQ(model.schedule().alphas_cumprod, make_schedule("squaredcos_cap_v2", 50, 0.5).alphas_cumprod);
   GenerateOptions o;
   o.sampler.sampler = "ddim";
   o.sampler.steps = 3;
