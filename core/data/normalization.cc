@@ -105,13 +105,29 @@ std::vector<std::vector<std::int32_t>> windows_by_sequence(const WindowDataset& 
   return starts;
 }
 
-at::Tensor read_vector(const NpzFile& f, const std::string& key, int64_t size, bool positive) {
-  const std::vector<double> v = as_vector<double>(f.get(key, {size}), f.where(key));
+// Frame weights of one sequence: the windows (starting at `starts`, `window` frames long)
+// each frame appears in as a real (not padded) frame.
+std::vector<double> frame_weights(const std::vector<std::int32_t>& starts, int window, int64_t frames) {
+  std::vector<double> weight(static_cast<std::size_t>(frames), 0.0);
+  for (std::int32_t start : starts)
+    for (int64_t f = start; f < std::min<int64_t>(start + window, frames); ++f) weight[static_cast<std::size_t>(f)] += 1;
+  return weight;
+}
+
+// A float64 array of `shape` (-1: any extent) from f[key], every value finite (and > 0
+// when `positive`); throws naming the key.
+at::Tensor read_array(const NpzFile& f, const std::string& key, const std::vector<int64_t>& shape, bool positive) {
+  const NpyArray& a = f.get(key, shape);
+  const std::vector<double> v = as_vector<double>(a, f.where(key));
   for (double x : v)
     if (!std::isfinite(x) || (positive && !(x > 0)))
       throw Error(f.where(key) + ": holds " + std::to_string(x) +
                   (positive ? " (must be positive and finite)" : " (not finite)"));
-  return at::tensor(v, at::kDouble);
+  return at::tensor(v, at::kDouble).view(a.shape);
+}
+
+at::Tensor read_vector(const NpzFile& f, const std::string& key, int64_t size, bool positive) {
+  return read_array(f, key, {size}, positive);
 }
 
 }  // namespace
@@ -201,10 +217,8 @@ at::Tensor contact_basis(const WindowDataset& train, const NormalizationStats& s
   double total = 0;
   for (std::size_t i = 0; i < seqs.size(); ++i) {
     const DatasetSequence& s = seqs[i];
-    std::vector<float> weight(static_cast<std::size_t>(s.frames), 0.0f);
-    for (std::int32_t start : starts[i])
-      for (int64_t f = start; f < std::min<int64_t>(start + w, s.frames); ++f) weight[static_cast<std::size_t>(f)] += 1;
-    const at::Tensor wt = at::tensor(weight, at::kFloat).repeat_interleave(2);  // [frames · 2]
+    const at::Tensor wt =
+        at::tensor(frame_weights(starts[i], w, s.frames), at::kDouble).to(at::kFloat).repeat_interleave(2);  // [frames · 2]
     const at::Tensor z =
         stats.normalize_c(s.contact_maps.to(at::kFloat).reshape({s.frames, 2, kBasisRows})).reshape({-1, kBasisRows});
     second += at::mm((z * wt.unsqueeze(1)).t(), z).to(at::kDouble);
@@ -212,10 +226,9 @@ at::Tensor contact_basis(const WindowDataset& train, const NormalizationStats& s
   }
   if (!(total > 0)) throw Error("contact basis: the windows hold no frames");
   const auto eig = at::linalg_eigh(second / total);                  // ascending eigenvalues
-  at::Tensor basis = std::get<1>(eig).flip({1}).slice(1, 0, k).contiguous();  // decreasing variance
-  const at::Tensor big = basis.abs().argmax(0, true);                          // [1, k]
-  basis = basis * basis.gather(0, big).sign();                                 // largest entry positive
-  return basis.contiguous();
+  const at::Tensor basis = std::get<1>(eig).flip({1}).slice(1, 0, k);  // decreasing variance
+  const at::Tensor big = basis.abs().argmax(0, true);                   // [1, k]
+  return (basis * basis.gather(0, big).sign()).contiguous();            // largest entry positive
 }
 
 NormalizationStats compute_normalization(const WindowDataset& train, double std_floor, double c_log_eps) {
@@ -240,14 +253,12 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
     for (int64_t i = 0; i < n; ++i) {
       const DatasetSequence& s = seqs[static_cast<std::size_t>(i)];
       const int64_t frames = s.frames;
-      // Frame weights: the windows each frame appears in as a real (not padded) frame.
-      std::vector<double> weight(static_cast<std::size_t>(frames), 0.0);
+      const std::vector<double> weight = frame_weights(starts[static_cast<std::size_t>(i)], w, frames);
       std::vector<double> g_rows;
       const float* S = s.states.data_ptr<float>();
       for (std::int32_t start : starts[static_cast<std::size_t>(i)]) {
         const float* first = S + 7 * start;
         for (int64_t f = start; f < std::min<int64_t>(start + w, frames); ++f) {
-          weight[static_cast<std::size_t>(f)] += 1;
           const float* st = S + 7 * f;
           for (int c = 0; c < 3; ++c) g_rows.push_back(st[1 + c]);
           // The same float32 arithmetic as WindowDataset::batch.
@@ -346,12 +357,9 @@ NormalizationStats read_normalization(const NpzFile& f, const std::string& prefi
   st.c_std = read_vector(f, prefix + "c_std", 2 * kBasisRows, true);
   if (f.contains(prefix + "c_basis")) {
     const std::string key = prefix + "c_basis";
-    const NpyArray& a = f.get(key, {kBasisRows, -1});
-    if (a.shape[1] < 1 || a.shape[1] > kBasisRows) throw Error(f.where(key) + " must have 1 to 1024 columns");
-    const std::vector<double> v = as_vector<double>(a, f.where(key));
-    for (double x : v)
-      if (!std::isfinite(x)) throw Error(f.where(key) + ": holds " + std::to_string(x) + " (not finite)");
-    st.c_basis = at::tensor(v, at::kDouble).view({kBasisRows, a.shape[1]});
+    st.c_basis = read_array(f, key, {kBasisRows, -1}, false);
+    if (st.c_basis.size(1) < 1 || st.c_basis.size(1) > kBasisRows)
+      throw Error(f.where(key) + " must have 1 to 1024 columns");
   }
   return st;
 }

@@ -61,9 +61,9 @@ void read(const std::string& file, const YAML::Node& map, const char* key, T& ou
   }
 }
 
-void set_sizes(DenoiserConfig& n, const std::string& model) {
+void set_sizes(DenoiserConfig& n, const std::string& model, int contact_basis) {
   n.model = model;
-  n.sample_size = model == "contact" ? 2 * kBasisRows : 1200;
+  n.sample_size = model != "contact" ? 1200 : contact_basis > 0 ? 2 * contact_basis : 2 * kBasisRows;
   n.object_condition_size = kObjectConditionSize;
   n.contact_condition_size = model == "contact" ? 0 : 2 * kBasisRows;
 }
@@ -254,8 +254,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "validation_windows", c.validation_windows);
     read(path, n, "log_every", c.log_every);
   }
-  set_sizes(c.network, c.model);
-  if (c.model == "contact" && c.contact_basis > 0) c.network.sample_size = 2 * c.contact_basis;
+  set_sizes(c.network, c.model, c.contact_basis);
   try {
     validate(c);
   } catch (const Error& e) {
