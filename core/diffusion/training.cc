@@ -5,6 +5,7 @@
 
 #include <ATen/ATen.h>
 #include <ATen/CPUGeneratorImpl.h>
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
@@ -511,6 +512,17 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     if (ck.info.network.describe() != config.network.describe())
       throw Error(checkpoint_path + ": the network differs from the config (" + ck.info.network.describe() +
                   " vs " + config.network.describe() + ")");
+    // The noise schedule and the contact basis define what the network learns: a resume
+    // must not change them silently.
+    const auto schedule_text = [](const ModelInfo& m) {
+      return m.schedule + ", " + std::to_string(m.diffusion_steps) + " steps, shift " + fmt::format("{:g}", m.schedule_shift);
+    };
+    if (schedule_text(ck.info) != schedule_text(info))
+      throw Error(checkpoint_path + ": the diffusion schedule differs from the config (" + schedule_text(ck.info) +
+                  " vs " + schedule_text(info) + ")");
+    if (ck.info.network.sample_size != info.network.sample_size)
+      throw Error(checkpoint_path + ": the contact basis differs from the config (sample size " +
+                  std::to_string(ck.info.network.sample_size) + " vs " + std::to_string(info.network.sample_size) + ")");
     if (ck.info.data_fingerprint != info.data_fingerprint)
       log::warn("{}: the training data changed since this run started (fingerprint {} vs {})", checkpoint_path,
                 ck.info.data_fingerprint, info.data_fingerprint);

@@ -20,6 +20,7 @@
 #include "core/diffusion/training.h"
 #include "core/util/error.h"
 #include "tests/data/tiny_dataset.h"
+#include "tests/error_of.h"
 
 namespace bimart::diffusion {
 namespace {
@@ -297,6 +298,32 @@ TEST(Training, ResumeRefusesAnotherNetwork) {
   c.network.latent = 32;
   o.resume = true;
   EXPECT_THROW(train(c, o), Error);
+}
+
+// What the network learns is set by the schedule and the contact basis too: a resume that
+// changes either is refused, with the two settings in the message.
+TEST(Training, ResumeRefusesAnotherScheduleShiftOrContactBasis) {
+  const fs::path dir = scratch("other_schedule");
+  TrainOptions o;
+  o.progress = false;
+  TrainConfig c = tiny_config(dir, "contact");
+  c.steps = 2;
+  c.contact_basis = 4;
+  c.network.sample_size = 8;
+  train(c, o);
+  o.resume = true;
+  TrainConfig shifted = c;
+  shifted.schedule_shift = 0.5;
+  const std::string shift_error = test::error_of([&] { train(shifted, o); });
+  EXPECT_NE(shift_error.find("shift 1 vs squaredcos_cap_v2, 50 steps, shift 0.5"), std::string::npos) << shift_error;
+  TrainConfig wider = c;
+  wider.contact_basis = 6;
+  wider.network.sample_size = 12;
+  const std::string basis_error = test::error_of([&] { train(wider, o); });
+  EXPECT_NE(basis_error.find("contact basis differs"), std::string::npos) << basis_error;
+  EXPECT_NE(basis_error.find("sample size 8 vs 12"), std::string::npos) << basis_error;
+  c.steps = 3;
+  EXPECT_TRUE(train(c, o).finished);  // the same settings resume
 }
 
 TEST(Training, TwoProcessesEqualOneOnTheUnionOfTheirBatches) {
