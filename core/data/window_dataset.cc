@@ -167,13 +167,6 @@ struct Inputs {
   bool half;
 };
 
-// Canonical-frame points [N, K, 3] to the world frame of each frame's root pose (float64).
-at::Tensor canonical_to_world_points(const at::Tensor& points, const at::Tensor& states) {
-  const at::Tensor s = states.to(at::kDouble);
-  const at::Tensor R = axis_angle_to_matrix_batch(s.narrow(1, 1, 3).contiguous());  // [N, 3, 3]
-  return at::matmul(points.to(at::kDouble), R.transpose(1, 2)) + s.narrow(1, 4, 3).unsqueeze(1);
-}
-
 DatasetSequence compute_sequence(const std::string& path, ObjectStore& objects, const Inputs& in) {
   at::NoGradGuard no_grad;
   const Sequence seq = read_sequence(path);
@@ -199,8 +192,7 @@ DatasetSequence compute_sequence(const std::string& path, ObjectStore& objects, 
                 " vertices per hand; the hand model's keypoints need " + std::to_string(max_id + 1) +
                 " (store full meshes, or no vertices so that the hands are posed)");
   const at::Tensor X = hand_features(hv, ids, *object, states);
-  const at::Tensor hit_points = canonical_to_world_points(basis_hit_points(*object, states, enc.hit_indices), states);
-  const at::Tensor C = contact_maps(hit_points, hv).to(at::kFloat);
+  const at::Tensor C = world_contact_maps(*object, states, enc.hit_indices, hv).to(at::kFloat);
 
   // Frames with the same hinge angle have the same O and hit indices: one row each.
   std::vector<int64_t> first_frame;

@@ -25,4 +25,10 @@ at::Tensor contact_maps(const at::Tensor& object_points, const at::Tensor& hand_
 // The pairwise path regardless of grad: the second implementation, for cross-checks.
 at::Tensor contact_maps_exhaustive(const at::Tensor& object_points, const at::Tensor& hand_points);
 
+// C [N, 2, 1024] of hands given in the world frame (`world_hand_points` [2, N, P, 3]): the
+// hit vertices (`hit_indices` [N, 1024]) posed by `states` [N, 7], then contact_maps. What
+// the training data holds, and contact.ground_truth gives.
+at::Tensor world_contact_maps(const ArticulatedObject& object, const at::Tensor& states, const at::Tensor& hit_indices,
+                              const at::Tensor& world_hand_points);
+
 }  // namespace bimart

@@ -72,6 +72,31 @@ TEST(ContactMap, HitPointsAreTheEncodersHitVertices) {
   EXPECT_LT((p - expected).abs().max().item<float>(), 1e-5);
 }
 
+// With both hands at the world position of hit vertex 0 (posed here with Eigen), every entry
+// is that vertex's distance to the row's vertex in the canonical frame: the root pose is
+// applied to the object points, and distances are rigid-invariant.
+TEST(ContactMap, WorldContactMapsPoseTheHitVerticesByTheRootPose) {
+  const ArticulatedObject o = make_object("laptop", 2);
+  at::Tensor s = at::zeros({2, 7}, at::kDouble);
+  s[0] = at::tensor({0.4, 0.3, -0.2, 0.9, 0.1, -0.5, 0.7}, at::kDouble);
+  s[1] = at::tensor({1.3, -1.1, 0.4, 0.2, -0.3, 0.2, 1.1}, at::kDouble);
+  const BpsBasis basis = load_bps_basis(find_data_file(default_basis_file(BpsVariant::PerPart)));
+  const ObjectEncoding e = encode_object(o, s.to(at::kFloat), basis, BpsVariant::PerPart);
+  const at::Tensor canonical = basis_hit_points(o, s, e.hit_indices).to(at::kDouble);  // [2, 1024, 3]
+  at::Tensor hands = at::zeros({2, 2, 1, 3}, at::kDouble);
+  for (int t = 0; t < 2; ++t) {
+    const Eigen::Isometry3d pose = canonical_to_world(ObjectState::from_row(s[t].contiguous().data_ptr<double>()));
+    const at::Tensor p0 = canonical[t][0];
+    const Eigen::Vector3d w = pose * Eigen::Vector3d(p0[0].item<double>(), p0[1].item<double>(), p0[2].item<double>());
+    for (int h = 0; h < 2; ++h) hands[h][t][0] = at::tensor({w.x(), w.y(), w.z()}, at::kDouble);
+  }
+  const at::Tensor c = world_contact_maps(o, s, e.hit_indices, hands);
+  ASSERT_EQ(c.sizes(), (at::IntArrayRef{2, 2, 1024}));
+  const at::Tensor expected = (canonical - canonical.narrow(1, 0, 1)).norm(2, {2});  // [2, 1024]
+  for (int h = 0; h < 2; ++h) EXPECT_LT((c.select(1, h) - expected).abs().max().item<double>(), 1e-9);
+  EXPECT_GT(expected.max().item<double>(), 0.1);  // the object spans decimetres: the test can tell
+}
+
 TEST(ContactMap, BadShapesAreClearErrors) {
   EXPECT_THROW(contact_maps(at::zeros({2, 5, 3}), at::zeros({2, 3, 4, 3})), Error);
   EXPECT_THROW(contact_maps(at::zeros({2, 5}), at::zeros({2, 2, 4, 3})), Error);
