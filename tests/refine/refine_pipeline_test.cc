@@ -1,5 +1,6 @@
 // refine.mano_fit and refine.ceres as pipeline stages, through the CLI: one synthetic
-// sequence, corrupted keypoints (motion.ground_truth), and two pipelines that differ by the
+// sequence, corrupted keypoints (motion.ground_truth, with contact.ground_truth's maps
+// written beside them), and two pipelines that differ by the
 // `refine` stage alone — the ablation rows "w C + CG" and "w C + CG + Opt". The refined
 // hands must be smoother and no deeper than the fitted ones; `bimart refine` on the same
 // folder must print its table.
@@ -13,6 +14,7 @@
 #include <ATen/ATen.h>
 #include <nlohmann/json.hpp>
 
+#include "core/features/contact_map.h"
 #include "core/io/sequence.h"
 #include "core/metrics/accel.h"
 #include "core/metrics/frame_depths.h"
@@ -31,6 +33,7 @@ std::string pipeline(const fs::path& sequence, const fs::path& out, bool refine)
   std::string y = "name: t\nseed: 0\nstages:\n"
                   "  - id: sequence\n    use: trajectory.sequence\n    params: {path: \"" + sequence.string() + "\"}\n"
                   "  - id: encoder\n    use: encoder.np_bps\n"
+                  "  - id: contact\n    use: contact.ground_truth\n"  // written with the sequence
                   "  - id: motion\n    use: motion.ground_truth\n    params: {seed: 3}\n"
                   "  - id: fit\n    use: refine.mano_fit\n";
   if (refine) y += "  - id: refine\n    use: refine.ceres\n";  // the one line between the rows
@@ -62,6 +65,14 @@ TEST(RefinePipeline, TheRefineStageMakesTheFitSmootherAndNoDeeper) {
   }
   const Sequence truth = read_sequence(sequence.string());
   const ArticulatedObject object = load_object(resolve_object_path(truth, sequence.string()));
+  // contact.ground_truth wrote the truth's contact maps on the encoder's rows; the synthetic
+  // hands touch the object somewhere in the sequence.
+  const at::Tensor C = results[0].contact_maps;
+  ASSERT_TRUE(C.defined() && results[0].basis_hit_indices.defined());
+  const at::Tensor expected =
+      world_contact_maps(object, truth.object_states, results[0].basis_hit_indices, hand_vertices(truth.hands));
+  EXPECT_LT((C - expected.to(at::kFloat)).abs().max().item<float>(), 1e-6);
+  EXPECT_LT(C.min().item<float>(), 0.005);
   const ObjectDistance distance(object);
   auto deepest = [&](const Sequence& s) {
     const FrameDepths d = frame_depths(distance, s.object_states, hand_vertices(s.hands));
