@@ -28,7 +28,6 @@
 #include "core/hand/keypoints.h"
 #include "core/io/sequence.h"
 #include "core/metrics/hand_vertices.h"
-#include "core/object/object_batch.h"
 #include "core/object/object_io.h"
 #include "core/util/atomic_file.h"
 #include "core/util/data_path.h"

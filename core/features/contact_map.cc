@@ -107,11 +107,8 @@ at::Tensor contact_maps_exhaustive(const at::Tensor& object_points, const at::Te
 
 at::Tensor world_contact_maps(const ArticulatedObject& object, const at::Tensor& states, const at::Tensor& hit_indices,
                               const at::Tensor& world_hand_points) {
-  const at::Tensor canonical = basis_hit_points(object, states, hit_indices);  // validates the shapes
-  const at::Tensor s = states.to(at::kDouble);
-  const at::Tensor R = axis_angle_to_matrix_batch(s.narrow(1, 1, 3).contiguous());  // [N, 3, 3]
-  const at::Tensor world = at::matmul(canonical.to(at::kDouble), R.transpose(1, 2)) + s.narrow(1, 4, 3).unsqueeze(1);
-  return contact_maps(world, world_hand_points);
+  // basis_hit_points validates the shapes.
+  return contact_maps(canonical_to_world_batch(basis_hit_points(object, states, hit_indices), states), world_hand_points);
 }
 
 }  // namespace bimart

@@ -62,4 +62,10 @@ PosedObjectBatch pose_object_batch(const ArticulatedObject& object, const at::Te
   return out;
 }
 
+at::Tensor canonical_to_world_batch(const at::Tensor& points, const at::Tensor& states) {
+  const at::Tensor s = states.to(at::kDouble);
+  const at::Tensor R = axis_angle_to_matrix_batch(s.narrow(1, 1, 3).contiguous());  // [N, 3, 3]
+  return at::matmul(points.to(at::kDouble), R.transpose(1, 2)) + s.narrow(1, 4, 3).unsqueeze(1);
+}
+
 }  // namespace bimart

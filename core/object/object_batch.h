@@ -19,4 +19,8 @@ PosedObjectBatch pose_object_batch(const ArticulatedObject& object, const at::Te
 // Batched Rodrigues: [N, 3] axis-angle -> [N, 3, 3], robust at zero angle.
 at::Tensor axis_angle_to_matrix_batch(const at::Tensor& axis_angle);
 
+// Canonical-frame points [N, K, 3] (articulation already applied) to the world frame by each
+// frame's root pose of `states` [N, 7]: float64 out.
+at::Tensor canonical_to_world_batch(const at::Tensor& points, const at::Tensor& states);
+
 }  // namespace bimart

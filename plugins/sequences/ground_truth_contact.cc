@@ -22,8 +22,7 @@ class GroundTruthContact : public ContactGenerator {
   }
   explicit GroundTruthContact(const Params&) {}
   void run(StageIO& io) override {
-    const at::Tensor& states = io.in<at::Tensor>("object_states");
-    const at::Tensor C = world_contact_maps(io.in<ArticulatedObject>("object"), states,
+    const at::Tensor C = world_contact_maps(io.in<ArticulatedObject>("object"), io.in<at::Tensor>("object_states"),
                                             io.in<at::Tensor>("basis_hit_indices"),
                                             hand_vertices(io.in<HandMotion>("ground_truth")));
     io.out("contact_maps", C.to(at::kFloat).contiguous());
