@@ -14,6 +14,7 @@ packages=(
   clang libclang-rt-14-dev                           # libFuzzer harnesses (scripts/test.sh --fuzz)
   python3 python3-numpy                              # tools/ converters (numpy only)
   blender chromium                                   # output tests: glTF import, viewer page (docs/outputs.md)
+  gnuplot-nox                                        # bimart sweep's table picture (docs/sweeps.md)
 )
 
 missing=()

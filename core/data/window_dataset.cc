@@ -32,6 +32,7 @@
 #include "core/util/atomic_file.h"
 #include "core/util/data_path.h"
 #include "core/util/error.h"
+#include "core/util/fingerprint.h"
 #include "core/util/log.h"
 #include "core/util/text.h"
 
@@ -45,25 +46,6 @@ constexpr int kObjectRow = kBasisRows * 3;         // O numbers per frame
 constexpr int kContactRow = 2 * kBasisRows;        // C numbers per frame
 constexpr const char kCacheMagic[9] = "BMFEAT01";  // 8 bytes, then the header length
 constexpr int kCacheVersion = 1;
-
-// FNV-1a, 64 bit: fingerprints of the inputs a cached feature file depends on.
-struct Fnv {
-  std::uint64_t h = 1469598103934665603ull;
-  void add(const void* data, std::size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-  }
-  void add(const std::string& s) { add(s.data(), s.size() + 1); }
-  template <class T>
-  void add_value(T v) {
-    add(&v, sizeof v);
-  }
-  std::string hex() const {
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-    return buf;
-  }
-};
 
 std::int64_t mtime_of(const fs::path& p) {
   std::error_code ec;

@@ -637,6 +637,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     }
     ++step;
     ++steps_this_call;
+    if (root) report_progress("train", static_cast<std::size_t>(step), static_cast<std::size_t>(config.steps));
     const double loss_all = dp ? dp->all_reduce_sum(lp.sum.item<double>()) / std::max(frames, 1.0) : loss.item<double>();
     interval_loss += loss_all;
     ++interval_steps;

@@ -75,8 +75,9 @@ struct GraphFile {
   static GraphFile parse(const std::string& text, const std::string& path,
                          const std::string& base_dir = ".");
 
-  // Applies "stage_id.param=value" (value in YAML, e.g. 64, 0.5, [1, 2], out.csv) or
-  // "seed=N". Unknown stages are reported here; unknown parameters at validation, with
+  // Applies "stage_id.param=value" (value in YAML, e.g. 64, 0.5, [1, 2], out.csv),
+  // "stage_id.use=kind.name" (another implementation of the stage, e.g. encoder.use=encoder.u_bps)
+  // or "seed=N". Unknown stages are reported here; unknown parameters at validation, with
   // the override as their location.
   void apply_override(const std::string& assignment);
 

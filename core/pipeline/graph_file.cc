@@ -165,6 +165,12 @@ void GraphFile::apply_override(const std::string& assignment) {
   for (auto& s : stages) {
     ids.push_back(s.id);
     if (s.id != stage_id) continue;
+    if (param == "use") {  // swap the implementation: stage_id.use=kind.name
+      if (!value.IsScalar()) throw Error(where, "use= takes a registered stage name, e.g. encoder.u_bps");
+      s.use = value.Scalar();
+      s.use_where = where;
+      return;
+    }
     for (auto& p : s.params)
       if (p.name == param) {
         p.value = value;

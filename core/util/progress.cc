@@ -4,13 +4,37 @@
 
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdlib>
 #include <iostream>
+#include <mutex>
+
+#include "core/util/atomic_file.h"
+#include "core/util/error.h"
 
 namespace bimart {
 
 namespace {
 std::atomic<bool> enabled{true};
 }  // namespace
+
+void report_progress(const std::string& label, std::size_t done, std::size_t total) {
+  static const char* const file = std::getenv("BIMART_PROGRESS_FILE");
+  if (file == nullptr || *file == '\0') return;
+  static std::mutex mutex;
+  static auto last = std::chrono::steady_clock::time_point{};
+  std::lock_guard<std::mutex> lock(mutex);
+  const auto now = std::chrono::steady_clock::now();
+  if (done < total && now - last < std::chrono::seconds(1)) return;
+  last = now;
+  try {
+    write_file_atomically(file, [&](std::ostream& o) {
+      o << fmt::format("{{\"label\": \"{}\", \"done\": {}, \"total\": {}}}\n", label, done, total);
+    });
+  } catch (const Error&) {
+    // Progress is a courtesy: a failed write must not stop the work.
+  }
+}
 
 void set_progress_enabled(bool e) { enabled = e; }
 bool progress_enabled() { return enabled; }
@@ -30,9 +54,10 @@ void ProgressBar::step() {
 }
 
 void ProgressBar::draw() {
+  const std::size_t done = done_;
+  report_progress(label_, done, total_);
   if (!show_) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  const std::size_t done = done_;
   constexpr int kWidth = 30;
   const int filled = total_ ? static_cast<int>(kWidth * done / total_) : kWidth;
   if (!tty_) {  // a log file: one line per tenth, not a redrawn bar

@@ -11,6 +11,12 @@
 
 namespace bimart {
 
+// When the environment variable BIMART_PROGRESS_FILE names a file (bimart sweep sets it
+// for each job it runs), progress is also written there as JSON {"label", "done",
+// "total"}, replaced atomically at most once a second and at the end. Every ProgressBar
+// reports; loops without a bar (training) call this.
+void report_progress(const std::string& label, std::size_t done, std::size_t total);
+
 void set_progress_enabled(bool enabled);
 bool progress_enabled();
 

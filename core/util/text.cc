@@ -1,5 +1,7 @@
 #include "core/util/text.h"
 
+#include <cmath>
+
 #include <cxxabi.h>
 
 #include <algorithm>
@@ -75,6 +77,15 @@ std::string demangle(const char* mangled) {
   std::unique_ptr<char, void (*)(void*)> out(abi::__cxa_demangle(mangled, nullptr, nullptr, &status),
                                              std::free);
   return status == 0 && out ? std::string(out.get()) : std::string(mangled);
+}
+
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = static_cast<long>(seconds + 0.5);
+  const auto two = [](long v) { return (v < 10 ? "0" : "") + std::to_string(v); };
+  if (s >= 3600) return std::to_string(s / 3600) + "h" + two(s % 3600 / 60) + "m";
+  if (s >= 60) return std::to_string(s / 60) + "m" + two(s % 60) + "s";
+  return std::to_string(s) + "s";
 }
 
 }  // namespace bimart

@@ -22,6 +22,9 @@ std::string did_you_mean(const std::string& wanted, const std::vector<std::strin
 // [a-z][a-z0-9_]* (kinds and names in stage keys).
 bool is_lower_identifier(const std::string& s, bool allow_leading_underscore = true);
 
+// "1h05m", "4m10s", "12s"; "?" for a negative or non-finite time.
+std::string format_duration(double seconds);
+
 std::string join(const std::vector<std::string>& parts, const std::string& sep);
 
 // Demangled C++ name of a type_info (falls back to the mangled name).

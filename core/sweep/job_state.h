@@ -1,0 +1,54 @@
+// What a sweep job has left on disk, read the same way by every backend and by `bimart
+// sweep status`: done.json (written last, atomically, with the job's key) marks a finished
+// job; progress.json is the running command's progress (BIMART_PROGRESS_FILE); log.txt its
+// output. A folder whose done.json holds another key is not done.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/sweep/plan.h"
+
+namespace bimart::sweep {
+
+std::string done_file(const Job& job);
+std::string log_file(const Job& job);
+std::string progress_file(const Job& job);
+
+// True when done.json exists, holds this job's key, and the job's result file exists.
+bool is_done(const Job& job);
+// Which jobs still have to run: those not done that a result needs. A finished
+// evaluation needs neither its samples nor its models any more, so a sweep folder whose
+// bulky outputs were deleted (or never copied) reruns nothing that is not missing.
+std::vector<bool> needed_jobs(const Plan& plan);
+
+// done.json's content ({} when absent or unreadable).
+nlohmann::json read_done(const Job& job);
+// Writes done.json: the key, seconds, threads, work and rate (work units per second).
+void mark_done(const Job& job, double seconds, int threads);
+
+struct Progress {
+  std::string label;
+  double done = 0, total = 0;
+  bool known = false;
+};
+Progress read_progress(const Job& job);
+
+// The last `lines` lines of the job's log ("" when there is none).
+std::string log_tail(const Job& job, int lines);
+
+// Measured rates (work units per second and thread) by rate key, kept in DIR/rates.json.
+std::map<std::string, double> read_rates(const std::string& dir);
+void record_rate(const std::string& dir, const std::string& rate_key, double per_thread);
+// Seconds a job should take with `threads` threads: from a measured rate when there is
+// one, else from defaults measured on the 2-core machine (docs/performance.md).
+double estimate_seconds(const Job& job, const std::map<std::string, double>& rates, int threads);
+
+// plan.json: the jobs (kind, name, key, folder, command, dependencies) and rows, for
+// `bimart sweep status` and cluster backends.
+void write_plan_json(const Plan& plan);
+Plan read_plan_json(const std::string& dir);
+
+}  // namespace bimart::sweep

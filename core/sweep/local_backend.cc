@@ -1,0 +1,260 @@
+#include "core/sweep/local_backend.h"
+
+#include <fcntl.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "core/sweep/job_state.h"
+#include "core/util/atomic_file.h"
+#include "core/util/error.h"
+#include "core/util/text.h"
+
+namespace bimart::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_sweep_signal(int) { g_stop = 1; }
+
+enum class State { Pending, Running, Done, Failed, Skipped };
+
+struct Running {
+  pid_t pid = -1;
+  int threads = 1;
+  Clock::time_point started, last_report;
+  // Progress of the current phase (its label): the first reading and the last, and when.
+  std::string label;
+  double first_done = -1, last_done = -1, total = 0;
+  Clock::time_point first_seen, last_seen;
+};
+
+std::string self_program() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw Error("cannot find this program's path (/proc/self/exe): " + ec.message());
+  return p.string();
+}
+
+std::vector<std::string> command_of(const Job& job, const std::string& program, int threads) {
+  std::vector<std::string> argv{program, "--threads", std::to_string(threads)};
+  argv.insert(argv.end(), job.args.begin(), job.args.end());
+  if (job.kind == JobKind::Train && fs::exists(fs::path(job.folder) / "checkpoint.npz")) argv.push_back("--resume");
+  return argv;
+}
+
+pid_t launch(const Job& job, const std::vector<std::string>& argv) {
+  fs::create_directories(job.folder);
+  fs::remove(progress_file(job));  // an earlier run's
+  if (job.kind == JobKind::Train)
+    write_file_atomically((fs::path(job.folder) / "config.yaml").string(), [&](std::ostream& o) { o << job.config_text; });
+  const std::string log = log_file(job);
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error("cannot write " + log + ": " + std::strerror(errno));
+  {
+    const std::time_t now = std::time(nullptr);
+    char when[32];
+    std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S", std::localtime(&now));
+    std::string line = fmt::format("==== {} {}\n", when, join(argv, " "));
+    ssize_t w = ::write(fd, line.data(), line.size());
+    (void)w;
+  }
+  std::vector<char*> cargv;
+  for (const auto& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
+  cargv.push_back(nullptr);
+  const std::string progress = progress_file(job);
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fd);
+    throw Error(std::string("cannot start a job: fork failed: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    // The child: stopped (and so checkpointed) with SIGTERM when the sweep dies, even by SIGKILL.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) ::_exit(143);
+    ::dup2(fd, STDOUT_FILENO);
+    ::dup2(fd, STDERR_FILENO);
+    ::setenv("BIMART_PROGRESS_FILE", progress.c_str(), 1);
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    ::execv(cargv[0], cargv.data());
+    const char msg[] = "bimart sweep: cannot execute the job's program\n";
+    ssize_t w = ::write(STDERR_FILENO, msg, sizeof msg - 1);
+    (void)w;
+    ::_exit(127);
+  }
+  ::close(fd);
+  return pid;
+}
+
+std::string job_label(const Job& job) { return fmt::format("{} {}", job_kind_name(job.kind), job.name); }
+
+}  // namespace
+
+RunSummary run_local(const Plan& plan, const LocalOptions& o) {
+  const auto t0 = Clock::now();
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int jobs = std::max(1, o.jobs);
+  const int total_threads = o.threads > 0 ? o.threads : cores;
+  const int per_job = std::max(1, total_threads / jobs);
+  const std::string program = o.program.empty() ? self_program() : o.program;
+  const auto rates = read_rates(plan.dir);
+
+  RunSummary sum;
+  std::vector<State> state(plan.jobs.size(), State::Pending);
+  const std::vector<bool> needed = needed_jobs(plan);
+  for (std::size_t i = 0; i < plan.jobs.size(); ++i)
+    if (!needed[i]) {  // done, or only feeding results that are done
+      state[i] = State::Done;
+      ++sum.already_done;
+    }
+  const int to_run = static_cast<int>(plan.jobs.size()) - sum.already_done;
+  if (!o.quiet)
+    std::cout << fmt::format("sweep {}: {} jobs, {} done before, {} to run ({} at a time, {} thread{} each)\n", plan.name,
+                             plan.jobs.size(), sum.already_done, to_run, jobs, per_job, per_job == 1 ? "" : "s")
+              << std::flush;
+
+  struct sigaction sa, old_int, old_term;
+  std::memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_sweep_signal;
+  sigemptyset(&sa.sa_mask);
+  g_stop = 0;
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+
+  std::map<std::size_t, Running> running;
+  int started = 0;
+  bool stopping = false;
+  while (true) {
+    if (g_stop && !stopping) {
+      stopping = true;
+      sum.interrupted = true;
+      if (!running.empty())
+        std::cout << fmt::format("stopping: {} running job{} write their checkpoints and stop\n", running.size(),
+                                 running.size() == 1 ? "" : "s")
+                  << std::flush;
+      for (const auto& [i, r] : running) ::kill(r.pid, SIGTERM);
+    }
+    // Start what is ready.
+    for (std::size_t i = 0; i < plan.jobs.size() && !stopping && static_cast<int>(running.size()) < jobs; ++i) {
+      if (state[i] != State::Pending) continue;
+      bool ready = true, blocked = false;
+      for (const std::size_t d : plan.jobs[i].deps) {
+        ready = ready && state[d] == State::Done;
+        blocked = blocked || state[d] == State::Failed || state[d] == State::Skipped;
+      }
+      if (blocked) {
+        state[i] = State::Skipped;
+        ++sum.skipped;
+        continue;
+      }
+      if (!ready) continue;
+      const Job& job = plan.jobs[i];
+      const auto argv = command_of(job, program, per_job);
+      Running r;
+      r.threads = per_job;
+      r.pid = launch(job, argv);
+      r.started = r.last_report = Clock::now();
+      running[i] = r;
+      state[i] = State::Running;
+      ++started;
+      if (!o.quiet)
+        std::cout << fmt::format("[{}/{}] start {}: estimate {}{}, log {}\n", started, to_run, job_label(job),
+                                 format_duration(estimate_seconds(job, rates, per_job)),
+                                 argv.back() == "--resume" ? " (resumes its checkpoint)" : "", log_file(job))
+                  << std::flush;
+    }
+    if (running.empty()) {
+      bool any_ready = false;
+      for (std::size_t i = 0; i < plan.jobs.size(); ++i) any_ready = any_ready || state[i] == State::Pending;
+      if (!any_ready || stopping) break;
+      continue;  // the loop above marks jobs behind a failure as skipped
+    }
+    // Reap finished children.
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    if (pid > 0) {
+      for (auto it = running.begin(); it != running.end(); ++it) {
+        if (it->second.pid != pid) continue;
+        const Job& job = plan.jobs[it->first];
+        const double secs = std::chrono::duration<double>(Clock::now() - it->second.started).count();
+        const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(job.result);
+        if (ok) {
+          mark_done(job, secs, it->second.threads);
+          // The rate of the last phase seen (a resumed training's steps of this run only).
+          const Running& r = it->second;
+          const double dt = std::chrono::duration<double>(r.last_seen - r.first_seen).count();
+          if (r.total > 0 && r.last_done > r.first_done && dt > 1)
+            record_rate(plan.dir, job.rate_key,
+                        (r.last_done - r.first_done) * job.work / r.total / dt / (1.0 + 0.6 * (r.threads - 1)));
+          state[it->first] = State::Done;
+          ++sum.ran;
+          if (!o.quiet)
+            std::cout << fmt::format("done  {} in {}\n", job_label(job), format_duration(secs)) << std::flush;
+        } else if (stopping) {
+          state[it->first] = State::Pending;  // interrupted: a rerun continues it
+          if (!o.quiet) std::cout << fmt::format("stopped {} (a rerun continues it)\n", job_label(job)) << std::flush;
+        } else {
+          state[it->first] = State::Failed;
+          ++sum.failed;
+          const std::string why = WIFEXITED(status) ? fmt::format("exit code {}", WEXITSTATUS(status))
+                                  : WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
+                                                        : std::string("no result");
+          std::cout << fmt::format("FAILED {} ({}); the end of {}:\n{}", job_label(job), why, log_file(job),
+                                   log_tail(job, 12))
+                    << std::flush;
+        }
+        running.erase(it);
+        break;
+      }
+      continue;
+    }
+    // Progress of the running jobs.
+    const auto now = Clock::now();
+    for (auto& [i, r] : running) {
+      const Progress p = read_progress(plan.jobs[i]);
+      if (p.known && (r.first_done < 0 || p.label != r.label)) {
+        r.label = p.label;
+        r.first_done = p.done;
+        r.first_seen = now;
+      }
+      if (p.known && p.done != r.last_done) {
+        r.last_done = p.done;
+        r.total = p.total;
+        r.last_seen = now;
+      }
+      if (o.quiet || std::chrono::duration<double>(now - r.last_report).count() < o.report_every) continue;
+      r.last_report = now;
+      std::string line = fmt::format("      {}: running {}", job_label(plan.jobs[i]),
+                                     format_duration(std::chrono::duration<double>(now - r.started).count()));
+      if (p.known) {
+        const double dt = std::chrono::duration<double>(now - r.first_seen).count();
+        const double rate = dt > 0 ? (p.done - r.first_done) / dt : 0;
+        line += fmt::format(", {} {:.0f}/{:.0f}", p.label, p.done, p.total);
+        if (rate > 0)
+          line += fmt::format(", {:.2f}/s, {} left", rate, format_duration((p.total - p.done) / rate));
+      }
+      std::cout << line << "\n" << std::flush;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return sum;
+}
+
+}  // namespace bimart::sweep
