@@ -120,7 +120,7 @@ int run_check(const CheckArgs& a) {
   const auto guidance_for = [&](int i) -> std::unique_ptr<diffusion::ContactMapGuidance> {
     if (!motion || (a.guidance <= 0 && a.place <= 0)) return nullptr;
     auto g = std::make_unique<diffusion::ContactMapGuidance>(
-        object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6)),
+        object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6), dopt.variant),
         b.contact_maps[i], a.guidance);
     g->set_placement(a.place);
     return g;
