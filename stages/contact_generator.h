@@ -20,6 +20,10 @@ class ContactGenerator : public Stage {
         .optional_input<at::Tensor>(
             "basis_points",
             "[1024, 3] float32; when wired, checked against the basis stored with the model")
+        .optional_input<std::string>(
+            "encoder_variant",
+            "the encoder's BPS variant (np_bps, npa_bps, u_bps); when wired, a model trained on "
+            "another is refused")
         .output<at::Tensor>(
             "contact_maps",
             "C: [N, 2, 1024] float32, metres (not scaled by s_o): per frame, hand (0 = left, "

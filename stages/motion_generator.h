@@ -29,6 +29,10 @@ class MotionGenerator : public Stage {
         .optional_input<at::Tensor>(
             "basis_points",
             "[1024, 3] float32; when wired, checked against the basis stored with the model")
+        .optional_input<std::string>(
+            "encoder_variant",
+            "the encoder's BPS variant (np_bps, npa_bps, u_bps); when wired, a model trained on "
+            "another is refused")
         .output<at::Tensor>(
             "hand_keypoints",
             "X: [N, 1200] float32, metres, canonical object frame: [H_left(300), "

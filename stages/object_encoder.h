@@ -44,7 +44,11 @@ class ObjectEncoder : public Stage {
         .output<at::Tensor>(
             "basis_points",
             "[1024, 3] float32: the stored basis point of each row, in encoder space "
-            "(NP-BPS: the 512 points twice); hit vertex = basis point + feature");
+            "(NP-BPS: the 512 points twice); hit vertex = basis point + feature")
+        .output<std::string>(
+            "encoder_variant",
+            "the BPS variant of O and of the basis rows: np_bps, npa_bps or u_bps (a model's "
+            "`variant`); the diffusion stages refuse a model trained on another");
   }
 };
 

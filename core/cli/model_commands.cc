@@ -22,6 +22,7 @@
 #include "core/data/window_dataset.h"
 #include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/generation.h"
+#include "core/diffusion/object_condition.h"
 #include "core/diffusion/sampler.h"
 #include "core/diffusion/schedule.h"
 #include "core/diffusion/temporal_band.h"
@@ -67,7 +68,7 @@ int run_check(const CheckArgs& a) {
   const std::vector<std::int64_t> idx = data.spread(std::max(1, a.windows));  // fixed by the data set alone
   const int n = static_cast<int>(idx.size());
   const WindowBatch b = data.batch(idx);
-  const at::Tensor obj = st.normalize_object(b.object_features, b.global_states);
+  const at::Tensor obj = diffusion::model_object_condition(info.network, st, b.object_features, b.global_states);
   const at::Tensor truth = motion ? b.hand_features : b.contact_maps.flatten(-2);  // metres
   const at::Tensor x0 = diffusion::normalized_sample(info.network.model, st, b);
   const auto to_metres = [&](const at::Tensor& z) {
@@ -119,7 +120,7 @@ int run_check(const CheckArgs& a) {
   const auto guidance_for = [&](int i) -> std::unique_ptr<diffusion::ContactMapGuidance> {
     if (!motion || (a.guidance <= 0 && a.place <= 0)) return nullptr;
     auto g = std::make_unique<diffusion::ContactMapGuidance>(
-        object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6)),
+        object_points_from_bps(b.object_features[i], data.basis_points(), b.global_states[i].select(1, 6), dopt.variant),
         b.contact_maps[i], a.guidance);
     g->set_placement(a.place);
     return g;
@@ -142,8 +143,9 @@ int run_check(const CheckArgs& a) {
     at::Tensor e_cond, e_uncond;
     if (!a.expert.empty()) {
       const auto e = diffusion::DiffusionModel::load(a.expert);
-      if (e->info().network.model != info.network.model || e->schedule().steps != sched.steps)
-        throw Error(a.expert + ": not a " + info.network.model + " model with the same schedule");
+      if (e->info().network.model != info.network.model || e->schedule().steps != sched.steps ||
+          e->info().network.object_condition_size != info.network.object_condition_size)
+        throw Error(a.expert + ": not a " + info.network.model + " model with the same schedule and object condition");
       expert = e->network();
       e_cond = motion && !a.no_contact ? expert->encode_conditions(obj, st.normalize_c(b.contact_maps).flatten(-2))
                                        : expert->encode_conditions(obj);

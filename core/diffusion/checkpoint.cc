@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "core/diffusion/object_condition.h"
 #include "core/hand/hand_model.h"
 #include "core/hand/keypoints.h"
 #include "core/io/npz.h"
@@ -55,7 +56,7 @@ struct IntField {
 };
 constexpr IntField kIntFields[] = {
     {"sample_size", &DenoiserConfig::sample_size},
-    {"object_condition_size", &DenoiserConfig::object_condition_size},
+    {"object_condition_size", &DenoiserConfig::object_condition_size},  // 3079 = [O | G], 3072 = O (w/o G)
     {"contact_condition_size", &DenoiserConfig::contact_condition_size},
     {"window", &DenoiserConfig::window},
     {"latent", &DenoiserConfig::latent},
@@ -86,6 +87,8 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   f.set("network/contact_cue", make_npy_scalar<std::int64_t>(i.network.contact_cue ? 1 : 0));
   for (const auto& field : kLaterIntFields)
     f.set(std::string("network/") + field.key, make_npy_scalar<std::int64_t>(i.network.*field.member));
+  // Spelled out beside object_condition_size (which decides it); files without it read G.
+  f.set("network/global_states", make_npy_scalar<std::int64_t>(reads_global_states(i.network) ? 1 : 0));
   set_string(f, "diffusion/schedule", i.schedule);
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
   if (i.schedule_shift != 1.0) f.set("diffusion/shift", make_npy_scalar<double>(i.schedule_shift));
@@ -143,6 +146,11 @@ Checkpoint load_checkpoint(const std::string& path) {
     if (f.contains(std::string("network/") + field.key)) read_field(field);
   try {
     i.network.validate();
+    // Older files have no network/global_states: their object condition (3079) says "with G".
+    const bool g = reads_global_states(i.network);
+    if (f.contains("network/global_states") && (get_int(f, "network/global_states") != 0) != g)
+      throw Error("network/global_states disagrees with an object condition of " +
+                  std::to_string(i.network.object_condition_size));
   } catch (const Error& e) {
     throw Error(path + ": " + e.what());
   }

@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include "core/data/normalization.h"
+#include "core/diffusion/object_condition.h"
 #include "core/diffusion/temporal_band.h"
 #include "core/util/error.h"
 
@@ -153,9 +154,9 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
     const at::Tensor o_w = O.slice(0, start, start + length).to(at::kFloat);
     at::Tensor g_w = G.slice(0, start, start + length).to(at::kFloat).clone();
     g_w.slice(1, 3, 6) -= g_w.slice(0, 0, 1).slice(1, 3, 6);
-    objs.push_back(st.normalize_object(o_w, g_w));
+    objs.push_back(model_object_condition(info.network, st, o_w, g_w));
   }
-  const at::Tensor obj = lay.per_sample(at::stack(objs, 0));  // [B, L, 3079]
+  const at::Tensor obj = lay.per_sample(at::stack(objs, 0));  // [B, L, 3079], or 3072 without G
   at::Tensor cond_emb;
   if (!motion) {
     cond_emb = net_->encode_conditions(obj);

@@ -22,6 +22,7 @@
 #include "core/data/window_dataset.h"
 #include "core/diffusion/checkpoint.h"
 #include "core/diffusion/distributed.h"
+#include "core/diffusion/object_condition.h"
 #include "core/diffusion/schedule.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
@@ -62,10 +63,10 @@ void read(const std::string& file, const YAML::Node& map, const char* key, T& ou
   }
 }
 
-void set_sizes(DenoiserConfig& n, const std::string& model, int contact_basis) {
+void set_sizes(DenoiserConfig& n, const std::string& model, int contact_basis, bool global_states) {
   n.model = model;
   n.sample_size = model != "contact" ? 1200 : contact_basis > 0 ? 2 * contact_basis : 2 * kBasisRows;
-  n.object_condition_size = kObjectConditionSize;
+  n.object_condition_size = object_condition_size(global_states);
   n.contact_condition_size = model == "contact" ? 0 : 2 * kBasisRows;
 }
 
@@ -214,7 +215,7 @@ TrainConfig load_train_config(const std::string& path) {
     check_keys(path, n, "network",
                {"latent", "layers", "heads", "feedforward", "condition_hidden", "dropout", "output", "skip_rank",
                 "contact_cue", "contact_points", "point_hidden", "contact_log_eps",
-                "contact_basis"});
+                "contact_basis", "global_states"});
     read(path, n, "latent", c.network.latent);
     read(path, n, "layers", c.network.layers);
     read(path, n, "heads", c.network.heads);
@@ -228,6 +229,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "point_hidden", c.network.point_hidden);
     read(path, n, "contact_log_eps", c.contact_log_eps);
     read(path, n, "contact_basis", c.contact_basis);
+    read(path, n, "global_states", c.global_states);
   }
   if (const YAML::Node n = root["diffusion"]) {
     check_keys(path, n, "diffusion", {"schedule", "steps", "shift"});
@@ -255,7 +257,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "validation_windows", c.validation_windows);
     read(path, n, "log_every", c.log_every);
   }
-  set_sizes(c.network, c.model, c.contact_basis);
+  set_sizes(c.network, c.model, c.contact_basis, c.global_states);
   try {
     validate(c);
   } catch (const Error& e) {
@@ -280,6 +282,10 @@ void validate(const TrainConfig& c) {
   if (c.model == "contact")
     need(c.network.sample_size == (c.contact_basis > 0 ? 2 * c.contact_basis : 2 * kBasisRows),
          "the contact model's sample size must be 2 x 'network.contact_basis' (or 2048 without a basis)");
+  need(c.network.object_condition_size == object_condition_size(c.global_states),
+       "the object condition must be " + std::to_string(object_condition_size(c.global_states)) + " wide " +
+           global_states_name(c.global_states) + " ('network.global_states'), got " +
+           std::to_string(c.network.object_condition_size));
   c.network.validate();
   make_schedule(c.schedule, c.diffusion_steps, c.schedule_shift);
   need(c.batch >= 1 && c.batch <= 100000, "'training.batch' must be in [1, 100000]");
@@ -316,7 +322,7 @@ StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stat
                             at::Generator gen) {
   StepInputs in;
   const auto B = b.hand_features.size(0);
-  in.object = stats.normalize_object(b.object_features, b.global_states);
+  in.object = model_object_condition(c.network, stats, b.object_features, b.global_states);
   in.sample = normalized_sample(c.model, stats, b);
   if (c.model == "motion") {
     in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
@@ -520,6 +526,10 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
     if (schedule_text(ck.info) != schedule_text(info))
       throw Error(checkpoint_path + ": the diffusion schedule differs from the config (" + schedule_text(ck.info) +
                   " vs " + schedule_text(info) + ")");
+    if (ck.info.network.object_condition_size != info.network.object_condition_size)
+      throw Error(checkpoint_path + ": the checkpoint's model reads " + std::to_string(ck.info.network.object_condition_size) +
+                  " object numbers per frame, the config " + std::to_string(info.network.object_condition_size) +
+                  " ('network.global_states')");
     if (ck.info.network.sample_size != info.network.sample_size)
       throw Error(checkpoint_path + ": the contact basis differs from the config (sample size " +
                   std::to_string(ck.info.network.sample_size) + " vs " + std::to_string(info.network.sample_size) + ")");
@@ -578,7 +588,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
                                              idx.begin() + static_cast<std::ptrdiff_t>(std::min(idx.size(), first + kChunk))});
       auto gen = at::detail::createCPUGenerator(static_cast<std::uint64_t>(1000003 + chunk));
       StepInputs in;
-      in.object = stats.normalize_object(b.object_features, b.global_states);
+      in.object = model_object_condition(config.network, stats, b.object_features, b.global_states);
       in.sample = normalized_sample(config.model, stats, b);
       if (config.model == "motion") in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
       in.mask = b.mask;

@@ -47,6 +47,10 @@ struct TrainConfig {
   // Contact model: > 0 samples C in the K principal directions per hand of the normalised
   // training maps (NormalizationStats::c_basis; a sample of 2K per frame). 0: all 2048.
   int contact_basis = 0;
+  // network.global_states: false = the object condition is O alone (3072 per frame), the
+  // paper's "w/o G" ablation; true = [O | G] (3079, the method). Sets
+  // network.object_condition_size (core/diffusion/object_condition.h).
+  bool global_states = true;
   std::string schedule = "squaredcos_cap_v2";
   double schedule_shift = 1;  // diffusion.shift: make_schedule's data scale (1 = none)
   int diffusion_steps = 50;
@@ -107,7 +111,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options);
 // processes) can feed explicit batches: the loss of a batch with given noise and steps.
 struct StepInputs {
   at::Tensor sample;     // [B, T, S] normalised clean sample (C or X)
-  at::Tensor object;     // [B, T, 3079] normalised [O | G]
+  at::Tensor object;     // [B, T, 3079] normalised [O | G], or [B, T, 3072] O (w/o G)
   at::Tensor contact;    // [B, T, 2048] normalised C (motion model) or undefined
   at::Tensor use_contact;  // [B] bool (motion model) or undefined
   at::Tensor mask;       // [B, T] 1 = real frame

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/features/bps.h"
 #include "core/util/error.h"
 
 namespace bimart {
@@ -41,6 +42,12 @@ at::Tensor object_points_from_bps(const at::Tensor& object_features, const at::T
                 std::string(c10::str(object_features.sizes())) + " and " + std::string(c10::str(basis_points.sizes())));
   const at::Tensor s = scale.dim() == 0 ? scale : scale.unsqueeze(-1).unsqueeze(-1);
   return (object_features + basis_points) / s;
+}
+
+at::Tensor object_points_from_bps(const at::Tensor& object_features, const at::Tensor& basis_points,
+                                  const at::Tensor& object_scale, BpsVariant variant) {
+  return object_points_from_bps(object_features, basis_points,
+                                variant == BpsVariant::Uniform ? at::ones_like(object_scale) : object_scale);
 }
 
 }  // namespace bimart

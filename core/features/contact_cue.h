@@ -12,6 +12,8 @@
 
 namespace bimart {
 
+enum class BpsVariant;  // core/features/bps.h
+
 constexpr int kContactCueTemperatures = 3;                                // σ = 1, 3, 10 cm
 constexpr int kContactCuePerHand = kContactCueTemperatures * 10 + 1;     // μ 3, cov 6, count 1; d_min
 constexpr int kContactCueSize = 2 * kContactCuePerHand;                   // 62, left hand first
@@ -28,5 +30,9 @@ at::Tensor contact_cue(const at::Tensor& points, const at::Tensor& contact_maps)
 // 1 for U-BPS).
 at::Tensor object_points_from_bps(const at::Tensor& object_features, const at::Tensor& basis_points,
                                   const at::Tensor& scale);
+// The same with the scale chosen by the encoder variant: `object_scale` s_o ([...] or a
+// number, e.g. G's last entry) for NPA-BPS and NP-BPS, 1 for U-BPS (metres already).
+at::Tensor object_points_from_bps(const at::Tensor& object_features, const at::Tensor& basis_points,
+                                  const at::Tensor& object_scale, BpsVariant variant);
 
 }  // namespace bimart

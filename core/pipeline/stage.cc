@@ -97,6 +97,11 @@ bool StageIO::has(const std::string& port) const {
   return false;
 }
 
+std::string StageIO::source(const std::string& port) const {
+  const std::string& key = input_key(port);  // "stage_id.port"
+  return key.substr(0, key.find('.'));
+}
+
 const std::string& StageIO::input_key(const std::string& port) const {
   for (const auto& kv : input_keys_)
     if (kv.first == port) return kv.second;

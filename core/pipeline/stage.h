@@ -116,6 +116,8 @@ class StageIO {
   }
   // True if an optional input is wired (required inputs always are).
   bool has(const std::string& port) const;
+  // The id of the stage whose output feeds input `port` (for messages that name it).
+  std::string source(const std::string& port) const;
 
   template <class T>
   void out(const std::string& port, T value) {

@@ -17,7 +17,8 @@ class ContactDiffusion : public ContactGenerator {
   static StageSpec spec() {
     StageSpec s = StageSpec::of<ContactGenerator>("diffusion", "contact maps from the contact diffusion model");
     diffusion_plugin::declare_sampling_params(s, "models/contact.npz");
-    s.output<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024] float32, metres: every sample (S = samples)");
+    s.output<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024] float32, metres: every sample (S = samples)")
+        .output<std::string>("contact_model", "the checkpoint sampled (motion.diffusion checks that it agrees with its own)");
     return s;
   }
 
@@ -28,14 +29,14 @@ class ContactDiffusion : public ContactGenerator {
 
   void run(StageIO& io) override {
     const auto t0 = std::chrono::steady_clock::now();
-    if (io.has("basis_points"))
-      diffusion::check_compatible(s_.model->info(), s_.model->path(), "contact", "", io.in<at::Tensor>("basis_points"), {});
+    diffusion_plugin::check_encoder(*s_.model, io);
     const at::Tensor C = s_.model->generate(io.in<at::Tensor>("object_features"), io.in<at::Tensor>("global_states"),
                                             {}, nullptr, s_.options, diffusion_plugin::stage_generator(io));
     log::info("contact.diffusion: {} frames x {} samples in {:.2f} s", C.size(1), C.size(0),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     io.out("contact_maps", C[0].contiguous());
     io.out("contact_maps_samples", C);
+    io.out("contact_model", s_.model->path());
   }
 
  private:

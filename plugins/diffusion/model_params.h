@@ -7,6 +7,7 @@
 #include <ATen/CPUGeneratorImpl.h>
 
 #include "core/diffusion/generation.h"
+#include "core/diffusion/object_condition.h"
 #include "core/pipeline/stage.h"
 #include "core/util/data_path.h"
 
@@ -42,6 +43,34 @@ inline Sampling read_sampling_params(const Params& p) {
   if (s.options.samples < 1 || s.options.samples > 1024)
     throw Error("'samples' must be in [1, 1024], got " + std::to_string(s.options.samples));
   return s;
+}
+
+// Before sampling: refuses a model trained on another encoder variant than the pipeline's
+// encoder stage gives (naming the model file and its variant, the stage and its variant),
+// then compares the basis points when they are wired (diffusion::check_compatible).
+inline void check_encoder(const diffusion::DiffusionModel& model, StageIO& io) {
+  const diffusion::ModelInfo& info = model.info();
+  if (io.has("encoder_variant")) {
+    const std::string& variant = io.in<std::string>("encoder_variant");
+    if (variant != info.variant)
+      throw Error(model.path() + " is a " + info.network.model + " model trained on " + info.variant +
+                  " features, but this pipeline's encoder stage '" + io.source("encoder_variant") + "' gives " +
+                  variant + " features: use encoder." + info.variant + " there, or a model trained with 'variant: " +
+                  variant + "'");
+  }
+  if (io.has("basis_points"))
+    diffusion::check_compatible(info, model.path(), info.network.model, "", io.in<at::Tensor>("basis_points"), {});
+}
+
+// Refuses contact maps sampled by a contact model of another Table 3 row than the motion
+// model's: another encoder variant, or G read by one and not the other.
+inline void check_contact_model(const diffusion::DiffusionModel& motion, const diffusion::DiffusionModel& contact) {
+  const auto row = [](const diffusion::ModelInfo& i) {
+    return i.variant + ", " + diffusion::global_states_name(diffusion::reads_global_states(i.network));
+  };
+  if (row(motion.info()) != row(contact.info()))
+    throw Error("the motion model " + motion.path() + " (" + row(motion.info()) + ") would be conditioned on maps of the contact model " +
+                contact.path() + " (" + row(contact.info()) + "): use models trained alike");
 }
 
 // libtorch generator seeded from the stage's own seeded stream.

@@ -22,6 +22,9 @@ class MotionDiffusion : public MotionGenerator {
         .param("use_contact", true, "condition on the contact maps; false = the null token (\"w/o C\")")
         .optional_input<at::Tensor>("contact_maps_samples",
                                     "[S, N, 2, 1024]: one contact map per sample (contact.diffusion's samples)")
+        .optional_input<std::string>("contact_model",
+                                     "the contact model that sampled the maps; refused unless it was trained on "
+                                     "the same encoder variant and with G as this model was, or both without")
         .output<at::Tensor>("hand_keypoints_samples", "[S, N, 1200] float32: every sample (S = samples)");
     return s;
   }
@@ -37,8 +40,12 @@ class MotionDiffusion : public MotionGenerator {
 
   void run(StageIO& io) override {
     const auto t0 = std::chrono::steady_clock::now();
-    if (io.has("basis_points"))
-      diffusion::check_compatible(s_.model->info(), s_.model->path(), "motion", "", io.in<at::Tensor>("basis_points"), {});
+    diffusion_plugin::check_encoder(*s_.model, io);
+    // The maps' own model only (a pipeline may hold other contact stages).
+    const auto maps_port = io.has("contact_maps_samples") ? "contact_maps_samples" : "contact_maps";
+    if (s_.options.use_contact && io.has("contact_model") && io.has(maps_port) &&
+        io.source("contact_model") == io.source(maps_port))
+      diffusion_plugin::check_contact_model(*s_.model, *diffusion::DiffusionModel::load(io.in<std::string>("contact_model")));
     at::Tensor C;
     if (s_.options.use_contact) {
       if (io.has("contact_maps_samples") && io.in<at::Tensor>("contact_maps_samples").size(0) == s_.options.samples)

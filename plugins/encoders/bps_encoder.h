@@ -4,6 +4,7 @@
 
 #include <ATen/ATen.h>
 
+#include "core/data/window_dataset.h"  // bps_variant_name
 #include "core/features/bps.h"
 #include "core/util/data_path.h"
 #include "stages/object_encoder.h"
@@ -33,6 +34,7 @@ class BpsEncoder : public ObjectEncoder {
     io.out("object_scale", e.scale);
     io.out("basis_hit_indices", e.hit_indices);
     io.out("basis_points", e.basis_points);
+    io.out("encoder_variant", bps_variant_name(V));
   }
 
  private:

@@ -72,6 +72,24 @@ TEST(ContactMap, HitPointsAreTheEncodersHitVertices) {
   EXPECT_LT((p - expected).abs().max().item<float>(), 1e-5);
 }
 
+// Every variant's features give back its hit vertices in metres: divided by s_o for the
+// normalised encoders, as they are for U-BPS (`bimart model check --guidance` divided U-BPS
+// points by s_o too, placing them 2-4x too close to the origin).
+TEST(ContactMap, EveryVariantsFeaturesGiveItsHitVertices) {
+  const ArticulatedObject o = make_object("box", 1);
+  at::Tensor s = at::zeros({2, 7});
+  s[0][0] = 0.2;
+  s[1][0] = 1.1;
+  for (BpsVariant v : {BpsVariant::Uniform, BpsVariant::PartAgnostic, BpsVariant::PerPart}) {
+    SCOPED_TRACE(static_cast<int>(v));
+    const BpsBasis basis = load_bps_basis(find_data_file(default_basis_file(v)));
+    const ObjectEncoding e = encode_object(o, s, basis, v);
+    const at::Tensor hits = basis_hit_points(o, s, e.hit_indices);
+    const at::Tensor s_o = e.global_states.select(1, 6);
+    EXPECT_LT((object_points_from_bps(e.features, e.basis_points, s_o, v) - hits).abs().max().item<float>(), 1e-5);
+  }
+}
+
 // With both hands at the world position of hit vertex 0 (posed here with Eigen), every entry
 // is that vertex's distance to the row's vertex in the canonical frame: the root pose is
 // applied to the object points, and distances are rigid-invariant.
