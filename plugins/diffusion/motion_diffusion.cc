@@ -5,6 +5,7 @@
 
 #include <chrono>
 
+#include "core/diffusion/representation.h"
 #include "core/pipeline/plugin.h"
 #include "core/util/log.h"
 #include "model_params.h"
@@ -31,8 +32,12 @@ class MotionDiffusion : public MotionGenerator {
     s_.options.use_contact = p.boolean("use_contact");
     if (s_.model->info().network.model != "motion")
       throw Error(s_.model->path() + " is a " + s_.model->info().network.model + " model, not a motion model");
+    if (s_.model->info().representation != diffusion::kKeypointsRepresentation)
+      throw Error("motion.diffusion samples keypoints X = [H | D], but " + s_.model->path() + " samples " +
+                  diffusion::describe_representation(s_.model->info().representation) +
+                  ": use motion.diffusion_mano for it");
     diffusion::check_compatible(s_.model->info(), s_.model->path(), "motion", "", {},
-                                diffusion::posing_keypoint_ids());
+                                diffusion::posing_keypoint_ids(), diffusion::kKeypointsRepresentation);
   }
 
   void run(StageIO& io) override {
