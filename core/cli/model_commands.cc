@@ -23,6 +23,7 @@
 #include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/generation.h"
 #include "core/diffusion/object_condition.h"
+#include "core/diffusion/representation.h"
 #include "core/diffusion/sampler.h"
 #include "core/diffusion/schedule.h"
 #include "core/diffusion/temporal_band.h"
@@ -58,6 +59,9 @@ int run_check(const CheckArgs& a) {
   const auto model = diffusion::DiffusionModel::load(a.checkpoint);
   const diffusion::ModelInfo& info = model->info();
   const bool motion = info.network.model == "motion";
+  if (motion && info.representation != diffusion::kKeypointsRepresentation)
+    throw Error("bimart model check measures keypoint errors; " + a.checkpoint + " samples " +
+                diffusion::describe_representation(info.representation) + ", which it does not check");
   const NormalizationStats& st = info.normalization;
   WindowDatasetOptions dopt;
   dopt.variant = parse_bps_variant(info.variant);
@@ -70,7 +74,7 @@ int run_check(const CheckArgs& a) {
   const WindowBatch b = data.batch(idx);
   const at::Tensor obj = diffusion::model_object_condition(info.network, st, b.object_features, b.global_states);
   const at::Tensor truth = motion ? b.hand_features : b.contact_maps.flatten(-2);  // metres
-  const at::Tensor x0 = diffusion::normalized_sample(info.network.model, st, b);
+  const at::Tensor x0 = diffusion::normalized_sample(info.network.model, info.representation, st, b);
   const auto to_metres = [&](const at::Tensor& z) {
     return motion ? st.denormalize_x(z) : st.contact_from_sample(z).flatten(-2);
   };

@@ -8,6 +8,7 @@
 
 #include "core/data/window_dataset.h"
 #include "core/features/hand_features.h"
+#include "core/features/mano_representation.h"
 #include "core/io/npz.h"
 #include "core/util/error.h"
 
@@ -156,6 +157,15 @@ at::Tensor denormalize(const at::Tensor& x, const at::Tensor& mean, const at::Te
 at::Tensor NormalizationStats::normalize_x(const at::Tensor& x) const { return normalize(x, x_mean, x_std); }
 at::Tensor NormalizationStats::denormalize_x(const at::Tensor& x) const { return denormalize(x, x_mean, x_std); }
 
+at::Tensor NormalizationStats::normalize_mano(const at::Tensor& m) const {
+  if (!mano_mean.defined()) throw Error("normalize_mano: these statistics hold no MANO representation");
+  return normalize(m, mano_mean, mano_std);
+}
+at::Tensor NormalizationStats::denormalize_mano(const at::Tensor& m) const {
+  if (!mano_mean.defined()) throw Error("denormalize_mano: these statistics hold no MANO representation");
+  return denormalize(m, mano_mean, mano_std);
+}
+
 at::Tensor NormalizationStats::normalize_object(const at::Tensor& object_features,
                                                 const at::Tensor& global_states) const {
   return normalize(object_condition(object_features, global_states), obj_mean, obj_std);
@@ -245,8 +255,11 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
   const std::vector<std::vector<std::int32_t>> starts = windows_by_sequence(train);
 
   struct Partial {
-    Moments x, o, c, g;
+    Moments x, o, c, g, m;
   };
+  // MANO-Rep statistics when every sequence holds it.
+  bool mano = true;
+  for (const DatasetSequence& s : seqs) mano = mano && s.mano.defined();
   // One sequence after the other, combined in sequence order.
   Partial all;
   {
@@ -269,6 +282,7 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
       }
       Partial p;
       p.x = moments_of(s.hand_features, frames, kHandFeatureSize, weight.data());
+      if (mano) p.m = moments_of(s.mano, frames, kManoRepSize, weight.data());
       const at::Tensor c = c_log_eps > 0 ? contact_space(s.contact_maps.to(at::kFloat), c_log_eps).contiguous()
                                          : s.contact_maps;
       p.c = moments_of(c, frames, 2 * kBasisRows, weight.data());
@@ -285,6 +299,7 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
       combine(all.c, p.c);
       combine(all.o, p.o);
       combine(all.g, p.g);
+      combine(all.m, p.m);
     }
   }
   if (all.x.weight <= 0) throw Error("normalisation statistics: the windows hold no frames");
@@ -298,6 +313,10 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
   st.x_std = floored_std(all.x, std_floor);
   st.c_mean = mean_of(all.c);
   st.c_std = floored_std(all.c, std_floor);
+  if (mano) {
+    st.mano_mean = mean_of(all.m);
+    st.mano_std = floored_std(all.m, std_floor);
+  }
   st.obj_mean = at::cat({mean_of(all.o), mean_of(all.g)});
   st.obj_std = at::cat({floored_std(all.o, std_floor), floored_std(all.g, std_floor)});
   return st;
@@ -322,6 +341,14 @@ void store_normalization(const NormalizationStats& stats, NpzFile& f, const std:
   f.set(prefix + "obj_std", npy_of(stats.obj_std));
   f.set(prefix + "c_mean", npy_of(stats.c_mean));
   f.set(prefix + "c_std", npy_of(stats.c_std));
+  if (stats.mano_mean.defined()) {
+    if (stats.mano_mean.dim() != 1 || stats.mano_mean.size(0) != kManoRepSize || !stats.mano_std.defined() ||
+        !stats.mano_std.sizes().equals(stats.mano_mean.sizes()))
+      throw Error("normalisation statistics have MANO-Rep vectors of shape " + shape_str(stats.mano_mean) + " and " +
+                  shape_str(stats.mano_std) + ", expected [" + std::to_string(kManoRepSize) + "]");
+    f.set(prefix + "mano_mean", npy_of(stats.mano_mean));
+    f.set(prefix + "mano_std", npy_of(stats.mano_std));
+  }
   if (stats.c_basis.defined()) {
     const at::Tensor b = stats.c_basis.to(at::kDouble).contiguous();
     if (b.dim() != 2 || b.size(0) != kBasisRows || b.size(1) < 1 || b.size(1) > kBasisRows)
@@ -355,6 +382,10 @@ NormalizationStats read_normalization(const NpzFile& f, const std::string& prefi
   st.obj_std = read_vector(f, prefix + "obj_std", kObjectConditionSize, true);
   st.c_mean = read_vector(f, prefix + "c_mean", 2 * kBasisRows, false);
   st.c_std = read_vector(f, prefix + "c_std", 2 * kBasisRows, true);
+  if (f.contains(prefix + "mano_mean") || f.contains(prefix + "mano_std")) {
+    st.mano_mean = read_vector(f, prefix + "mano_mean", kManoRepSize, false);
+    st.mano_std = read_vector(f, prefix + "mano_std", kManoRepSize, true);
+  }
   if (f.contains(prefix + "c_basis")) {
     const std::string key = prefix + "c_basis";
     st.c_basis = read_array(f, key, {kBasisRows, -1}, false);

@@ -5,6 +5,8 @@
 //   [O flattened | G] (3072 + 7)   the object condition of both models,
 //   C (2048)                       contact maps, the contact model's sample and the motion
 //                                  model's condition,
+//   MANO-Rep (294)                 when the data set holds it (WindowDatasetOptions::mano):
+//                                  a MANO-Rep motion model's sample,
 // over the TRAIN split only. Statistics are taken over every (window, real frame) pair —
 // each frame weighted by the number of windows it appears in, padding excluded — which is
 // the distribution WindowDataset::batch draws from; G's translation is per window anyway.
@@ -35,6 +37,7 @@ struct NormalizationStats {
   at::Tensor x_mean, x_std;      // [1200]
   at::Tensor obj_mean, obj_std;  // [3079]
   at::Tensor c_mean, c_std;      // [2048]
+  at::Tensor mano_mean, mano_std;  // [294] MANO-Rep; undefined unless computed from a data set holding it
   // > 0: C is normalised in log space, z = (log(C + c_log_eps) − c_mean) / c_std (metres; a
   // contact model's sample, so that the few centimetres that decide contact are not lost
   // beside distances of 30 cm); 0: z = (C − c_mean) / c_std.
@@ -49,6 +52,9 @@ struct NormalizationStats {
   // X [..., 1200] -> normalised, same shape and dtype; and back.
   at::Tensor normalize_x(const at::Tensor& x) const;
   at::Tensor denormalize_x(const at::Tensor& x) const;
+  // MANO-Rep [..., 294] -> normalised, and back; throws when the statistics have none.
+  at::Tensor normalize_mano(const at::Tensor& m) const;
+  at::Tensor denormalize_mano(const at::Tensor& m) const;
   // O [..., 1024, 3] and G [..., 7] -> the normalised object condition [..., 3079].
   at::Tensor normalize_object(const at::Tensor& object_features, const at::Tensor& global_states) const;
   // C [..., 2, 1024] -> normalised (in log space when c_log_eps > 0), same shape; and back.
@@ -73,8 +79,8 @@ NormalizationStats compute_normalization(const WindowDataset& train, double std_
 at::Tensor contact_basis(const WindowDataset& train, const NormalizationStats& stats, int k);
 
 // .npz with keys x_mean, x_std, obj_mean, obj_std, c_mean, c_std (f8), variant (string),
-// count (i8), std_floor (f8), format_version (i8), and c_log_eps (f8) and c_basis (f8
-// [1024, K]) when set; written atomically.
+// count (i8), std_floor (f8), format_version (i8), and c_log_eps (f8), c_basis (f8
+// [1024, K]) and mano_mean, mano_std (f8 [294]) when set; written atomically.
 void save_normalization(const NormalizationStats& stats, const std::string& path);
 // Throws bimart::Error naming the file and key on a missing key, a wrong shape or a
 // standard deviation that is not positive and finite.

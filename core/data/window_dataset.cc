@@ -24,6 +24,7 @@
 #include "core/data/manifest.h"
 #include "core/features/contact_map.h"
 #include "core/features/hand_features.h"
+#include "core/features/mano_representation.h"
 #include "core/hand/hand_model.h"
 #include "core/hand/keypoints.h"
 #include "core/io/sequence.h"
@@ -71,6 +72,8 @@ std::int64_t object_stamp(const std::string& path) {
 struct HandInfo {
   std::vector<int> keypoints;
   std::string fingerprint;
+  std::array<HandModel, 2> models;  // for the MANO representation's joints
+  std::array<const HandModel*, 2> pointers() const { return {&models[0], &models[1]}; }
 };
 
 const HandInfo& hand_info() {
@@ -85,7 +88,7 @@ const HandInfo& hand_info() {
     std::vector<int> ids[2];
     for (int h = 0; h < 2; ++h) {
       const std::string& path = files[h];
-      const HandModel model = load_hand_model(path);
+      const HandModel& model = info->models[static_cast<std::size_t>(h)] = load_hand_model(path);
       try {
         ids[h] = model_keypoints(model);
       } catch (const Error& e) {
@@ -146,6 +149,7 @@ struct Inputs {
   const BpsBasis* basis;
   std::string basis_fingerprint;
   bool half;
+  bool mano;
 };
 
 DatasetSequence compute_sequence(const std::string& path, ObjectStore& objects, const Inputs& in) {
@@ -205,6 +209,7 @@ DatasetSequence compute_sequence(const std::string& path, ObjectStore& objects, 
   d.hit_indices = h_rows.index_select(1, dynamic).to(hit_type).contiguous();
   d.contact_maps = C.to(store).contiguous();
   d.hand_features = X.to(store).contiguous();
+  if (in.mano) d.mano = mano_representation(hand_info().pointers(), seq.hands, states).to(store).contiguous();
   return d;
 }
 
@@ -241,12 +246,16 @@ json cache_header(const DatasetSequence& d, const Inputs& in, const SourceStamp&
           {"frames", d.frames},
           {"rows", d.object_features.size(0)},
           {"dynamic_rows", d.dynamic_rows.size(0)},
-          {"hit_dtype", d.hit_template.scalar_type() == at::kShort ? "i2" : "i4"}};
+          {"hit_dtype", d.hit_template.scalar_type() == at::kShort ? "i2" : "i4"},
+          {"mano", d.mano.defined()}};  // the MANO representation follows the other tensors
 }
 
 std::vector<const at::Tensor*> cache_tensors(const DatasetSequence& d) {
-  return {&d.states,          &d.feature_row, &d.object_template, &d.hit_template, &d.dynamic_rows,
-          &d.object_features, &d.hit_indices, &d.contact_maps,    &d.hand_features};
+  std::vector<const at::Tensor*> t{&d.states,          &d.feature_row, &d.object_template,
+                                   &d.hit_template,    &d.dynamic_rows, &d.object_features,
+                                   &d.hit_indices,     &d.contact_maps, &d.hand_features};
+  if (d.mano.defined()) t.push_back(&d.mano);
+  return t;
 }
 
 void write_cache(const std::string& file, const DatasetSequence& d, const Inputs& in, const SourceStamp& src) {
@@ -286,6 +295,10 @@ std::optional<DatasetSequence> read_cache(const std::string& file, const std::st
     if (h.at("storage").get<std::string>() != (in.half ? "f2" : "f4")) return stale("other storage type");
     if (h.at("basis").get<std::string>() != in.basis_fingerprint) return stale("other basis");
     if (h.at("hands").get<std::string>() != hand_info().fingerprint) return stale("other hand model");
+    // Files written before the MANO representation existed have no "mano" entry: valid
+    // without it, stale for a data set that needs it.
+    const bool has_mano = h.value("mano", false);
+    if (in.mano && !has_mano) return stale("no MANO representation");
     if (h.at("source_size").get<std::uint64_t>() != src.size || h.at("source_mtime").get<std::int64_t>() != src.mtime)
       return stale("the sequence file changed");
     DatasetSequence d;
@@ -311,6 +324,7 @@ std::optional<DatasetSequence> read_cache(const std::string& file, const std::st
     d.hit_indices = at::empty({u, dyn}, hit_type);
     d.contact_maps = at::empty({n, 2, kBasisRows}, store);
     d.hand_features = at::empty({n, kHandFeatureSize}, store);
+    if (has_mano) d.mano = at::empty({n, kManoRepSize}, store);
     for (const at::Tensor* t : cache_tensors(d))
       if (!f.read(static_cast<char*>(t->data_ptr()), static_cast<std::streamsize>(t->nbytes())))
         return stale("truncated data");
@@ -321,6 +335,7 @@ std::optional<DatasetSequence> read_cache(const std::string& file, const std::st
     const int32_t* dr = d.dynamic_rows.data_ptr<int32_t>();
     for (int64_t k = 0; k < dyn; ++k)
       if (dr[k] < 0 || dr[k] >= kBasisRows || (k > 0 && dr[k] <= dr[k - 1])) return stale("bad dynamic rows");
+    if (!in.mano) d.mano = at::Tensor();  // read past, not kept
     return d;
   } catch (const std::exception& e) {
     return stale(std::string("unreadable header: ") + e.what());
@@ -455,7 +470,7 @@ WindowDataset WindowDataset::load(const std::vector<std::string>& files, const s
     throw Error(ds.basis_file_ + ": the basis has " + std::to_string(ds.basis_.points.rows()) + " points; " +
                 bps_variant_name(options.variant) + " needs " + std::to_string(basis_size(options.variant)));
   hand_info();  // load the hand models once, before the workers start
-  const Inputs in{options.variant, &ds.basis_, basis_fingerprint(ds.basis_), options.half_precision};
+  const Inputs in{options.variant, &ds.basis_, basis_fingerprint(ds.basis_), options.half_precision, options.mano};
 
   const std::size_t n = files.size();
   ds.sequences_.resize(n);
@@ -571,6 +586,8 @@ WindowBatch WindowDataset::batch(const std::vector<std::int64_t>& indices) const
   at::Tensor O = at::empty({b_count, w, kBasisRows, 3}, store);
   at::Tensor C = at::empty({b_count, w, 2, kBasisRows}, store);
   at::Tensor X = at::empty({b_count, w, kHandFeatureSize}, store);
+  const bool mano = sequences_.front().mano.defined();
+  at::Tensor M = mano ? at::empty({b_count, w, kManoRepSize}, store) : at::Tensor();
   WindowBatch out;
   out.hit_indices = at::empty({b_count, w, kBasisRows}, at::kLong);
   out.global_states = at::empty({b_count, w, 7}, at::kFloat);
@@ -581,6 +598,7 @@ WindowBatch WindowDataset::batch(const std::vector<std::int64_t>& indices) const
   char* o_out = static_cast<char*>(O.data_ptr());
   char* c_out = static_cast<char*>(C.data_ptr());
   char* x_out = static_cast<char*>(X.data_ptr());
+  char* m_rep_out = mano ? static_cast<char*>(M.data_ptr()) : nullptr;
   int64_t* h_out = out.hit_indices.data_ptr<int64_t>();
   float* g_out = out.global_states.data_ptr<float>();
   float* s_out = out.object_states.data_ptr<float>();
@@ -616,6 +634,9 @@ WindowBatch WindowDataset::batch(const std::vector<std::int64_t>& indices) const
         }
         std::memcpy(c_out + bi * kContactRow * es, c_in + f * kContactRow * es, kContactRow * es);
         std::memcpy(x_out + bi * kHandFeatureSize * es, x_in + f * kHandFeatureSize * es, kHandFeatureSize * es);
+        if (mano)
+          std::memcpy(m_rep_out + bi * kManoRepSize * es, static_cast<const char*>(s.mano.data_ptr()) + f * kManoRepSize * es,
+                      kManoRepSize * es);
         int64_t* h = h_out + bi * kBasisRows;
         if (short_hits) {
           const int16_t* tmpl = s.hit_template.data_ptr<int16_t>();
@@ -643,6 +664,7 @@ WindowBatch WindowDataset::batch(const std::vector<std::int64_t>& indices) const
   out.object_features = O.to(at::kFloat);
   out.contact_maps = C.to(at::kFloat);
   out.hand_features = X.to(at::kFloat);
+  if (mano) out.mano = M.to(at::kFloat);
   return out;
 }
 

@@ -1,7 +1,8 @@
 // Training windows for both diffusion models (DESIGN §4, §5; docs/data_loader.md): the
 // sequences of one split of a data set, cut into windows of W = 64 frames, with the
 // features every model reads — O (BPS object features), G (global states), C (contact maps
-// from the hand meshes), X (hand features [H | D]) and the basis hit indices.
+// from the hand meshes), X (hand features [H | D]) and the basis hit indices — and, on
+// request, the MANO representation of the hands (core/features/mano_representation.h).
 //
 // Features are computed once per sequence (never per window), sequences in parallel, and
 // kept compactly in memory: O, C and X as float16, hit indices as int16, frames with the
@@ -45,6 +46,9 @@ struct WindowDatasetOptions {
   int stride = 16;
   // O, C, X as float16 (|error| <= 2^-11 |x| + 2^-25, docs/data_loader.md); false: float32.
   bool half_precision = true;
+  // Also the MANO representation of each sequence's hands (MANO-Rep motion models), from
+  // its MANO parameters posed with the posing hand models (core/metrics/hand_vertices.h).
+  bool mano = false;
   // Per-sequence feature cache on disk (WindowDataset::open only, unless cache_dir is set).
   bool cache = true;
   std::string cache_dir;  // "" = FOLDER/cache/<variant>
@@ -63,6 +67,7 @@ struct WindowBatch {
                                //   the window's first frame, s_o
   at::Tensor contact_maps;     // C [B, W, 2, 1024], metres, left hand first
   at::Tensor hand_features;    // X [B, W, 1200], canonical frame, [H_l, H_r, D_l, D_r]
+  at::Tensor mano;             // MANO-Rep [B, W, 294], canonical frame; undefined unless the data set holds it
   at::Tensor hit_indices;      // [B, W, 1024] int64 into the object's [top; bottom] vertices
   at::Tensor mask;             // [B, W]: 1 for a frame of the sequence, 0 for padding
   at::Tensor object_states;    // [B, W, 7] the raw 7-DoF states (padding repeats the last)
@@ -90,6 +95,7 @@ struct DatasetSequence {
   at::Tensor hit_indices;          // [U, D]
   at::Tensor contact_maps;         // [N, 2, 1024] float16 / float32
   at::Tensor hand_features;        // [N, 1200] float16 / float32
+  at::Tensor mano;                 // [N, 294] float16 / float32 MANO-Rep, or undefined (WindowDatasetOptions::mano)
   std::size_t bytes() const;       // memory held by the tensors above
   at::Tensor object_rows() const;  // [U, 1024, 3] float32: every basis row, rebuilt
   at::Tensor hit_rows() const;     // [U, 1024] int64

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/diffusion/object_condition.h"
+#include "core/diffusion/representation.h"
 #include "core/hand/hand_model.h"
 #include "core/hand/keypoints.h"
 #include "core/io/npz.h"
@@ -93,6 +94,7 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   f.set("diffusion/steps", make_npy_scalar<std::int64_t>(i.diffusion_steps));
   if (i.schedule_shift != 1.0) f.set("diffusion/shift", make_npy_scalar<double>(i.schedule_shift));
   set_string(f, "encoder/variant", i.variant);
+  set_string(f, "representation", i.representation);
   if (!i.basis_points.defined()) throw Error(path + ": checkpoint without basis points");
   f.set("encoder/basis_points", npy_from_tensor(i.basis_points.to(at::kFloat)));
   f.set("hand/keypoints", make_npy(i.keypoints));
@@ -158,6 +160,16 @@ Checkpoint load_checkpoint(const std::string& path) {
   i.diffusion_steps = static_cast<int>(get_int(f, "diffusion/steps"));
   if (f.contains("diffusion/shift")) i.schedule_shift = f.vector<double>("diffusion/shift").at(0);
   i.variant = get_string(f, "encoder/variant");
+  // Checkpoints from before MANO-Rep sample keypoints.
+  i.representation = f.contains("representation") ? get_string(f, "representation") : kKeypointsRepresentation;
+  try {
+    check_representation_name(i.representation);
+    if (i.network.model == "motion" && i.network.sample_size != motion_sample_size(i.representation))
+      throw Error("representation " + i.representation + " samples " + std::to_string(motion_sample_size(i.representation)) +
+                  " numbers per frame, the network " + std::to_string(i.network.sample_size));
+  } catch (const Error& e) {
+    throw Error(f.where("representation") + ": " + e.what());
+  }
   i.basis_points = tensor_from_npy(f.get("encoder/basis_points", {-1, 3}), f.where("encoder/basis_points"));
   i.keypoints = f.vector<std::int64_t>("hand/keypoints");
   i.normalization = read_normalization(f, "normalization/");
@@ -221,10 +233,13 @@ Denoiser make_denoiser(const Checkpoint& checkpoint, const std::string& what) {
 
 void check_compatible(const ModelInfo& info, const std::string& what, const std::string& model,
                       const std::string& variant, const at::Tensor& basis_points,
-                      const std::vector<std::int64_t>& keypoints) {
+                      const std::vector<std::int64_t>& keypoints, const std::string& representation) {
   std::vector<std::string> differs;
   if (!model.empty() && info.network.model != model)
     differs.push_back("it is a " + info.network.model + " model, not a " + model + " model");
+  if (!representation.empty() && info.representation != representation)
+    differs.push_back("hand representation: the model samples " + describe_representation(info.representation) +
+                      ", this run needs " + describe_representation(representation));
   if (!variant.empty() && info.variant != variant)
     differs.push_back("encoder variant: trained with " + info.variant + ", run with " + variant);
   if (basis_points.defined()) {

@@ -31,6 +31,8 @@ struct ModelInfo {
   int diffusion_steps = 50;
   double schedule_shift = 1;       // make_schedule's shift (1 = none)
   std::string variant = "np_bps";  // encoder of O (bps_variant_name)
+  // The motion model's sample (core/diffusion/representation.h); files without it: "keypoints".
+  std::string representation = "keypoints";
   at::Tensor basis_points;         // [1024, 3] float32, encoder space
   std::vector<std::int64_t> keypoints;  // J = 100 hand keypoint vertex ids
   NormalizationStats normalization;
@@ -75,9 +77,10 @@ Denoiser make_denoiser(const Checkpoint& checkpoint, const std::string& what);
 
 // Throws bimart::Error naming `what` (the checkpoint) and each thing that differs from
 // what the caller runs with: model kind, encoder variant, basis points (max difference),
-// keypoint ids. An undefined basis or empty keypoints is not checked.
+// keypoint ids, hand representation. An empty model, variant or representation, an
+// undefined basis or empty keypoints is not checked.
 void check_compatible(const ModelInfo& info, const std::string& what, const std::string& model,
                       const std::string& variant, const at::Tensor& basis_points,
-                      const std::vector<std::int64_t>& keypoints);
+                      const std::vector<std::int64_t>& keypoints, const std::string& representation = "");
 
 }  // namespace bimart::diffusion

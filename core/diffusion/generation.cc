@@ -9,6 +9,7 @@
 
 #include "core/data/normalization.h"
 #include "core/diffusion/object_condition.h"
+#include "core/diffusion/representation.h"
 #include "core/diffusion/temporal_band.h"
 #include "core/util/error.h"
 
@@ -38,6 +39,8 @@ DiffusionModel::DiffusionModel(Checkpoint checkpoint, std::string path)
     throw Error(path_ + ": the contact model samples " + std::to_string(i.network.sample_size) +
                 " numbers per frame, but its statistics' contact basis gives " +
                 std::to_string(i.normalization.contact_sample_size()));
+  if (i.network.model == "motion" && i.representation == kManoRepresentation && !i.normalization.mano_mean.defined())
+    throw Error(path_ + ": a MANO-Rep motion model without MANO-Rep normalisation statistics");
 }
 
 std::vector<std::pair<std::int64_t, std::int64_t>> DiffusionModel::windows(std::int64_t frames, int window,
@@ -134,6 +137,10 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   if (O.dim() != 3 || O.size(1) != 1024 || O.size(2) != 3 || G.dim() != 2 || G.size(0) != N || G.size(1) != 7)
     throw Error("generate: need O [N, 1024, 3] and G [N, 7], got " + c10::str(O.sizes()) + " and " + c10::str(G.sizes()));
   if (N < 1) throw Error("generate: the trajectory has no frames");
+  const bool mano = motion && info.representation == kManoRepresentation;
+  if (mano && guidance != nullptr)
+    throw Error(path_ + ": guidance corrects keypoints X = [H | D], but this model samples the MANO representation "
+                "(MANO-Rep): run it without a guidance stage");
   at::Tensor contact;
   if (motion && o.use_contact) {
     if (!C.defined()) throw Error(path_ + ": the motion model needs contact maps (or use_contact off)");
@@ -199,7 +206,7 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   const StepHook hook = [&](int, int, at::Tensor& x) { x = agree(x); };
   const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, hook));
   if (!motion) return st.contact_from_sample(result).clamp_min(0.0);
-  return st.denormalize_x(result);
+  return mano ? st.denormalize_mano(result) : st.denormalize_x(result);
 }
 
 }  // namespace bimart::diffusion

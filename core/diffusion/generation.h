@@ -50,7 +50,8 @@ class DiffusionModel {
   // fixed frame: each window subtracts its own first translation); contact_maps (motion
   // model) [N, 2, 1024] or [S, N, 2, 1024] in metres, or undefined when use_contact is false.
   // Returns, denormalised: contact model C [S, N, 2, 1024] (m, clamped at 0); motion
-  // model X [S, N, 1200] (m, canonical frame).
+  // model X [S, N, 1200] (m, canonical frame), or for a MANO-Rep model (which takes no
+  // guidance) its sample [S, N, 294] (core/features/mano_representation.h).
   at::Tensor generate(const at::Tensor& object_features, const at::Tensor& global_states,
                       const at::Tensor& contact_maps, const Guidance* guidance, const GenerateOptions& options,
                       at::Generator gen) const;

@@ -23,11 +23,13 @@
 #include "core/diffusion/checkpoint.h"
 #include "core/diffusion/distributed.h"
 #include "core/diffusion/object_condition.h"
+#include "core/diffusion/representation.h"
 #include "core/diffusion/schedule.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "core/util/progress.h"
+#include "core/util/text.h"
 
 namespace fs = std::filesystem;
 
@@ -63,9 +65,11 @@ void read(const std::string& file, const YAML::Node& map, const char* key, T& ou
   }
 }
 
-void set_sizes(DenoiserConfig& n, const std::string& model, int contact_basis, bool global_states) {
+void set_sizes(DenoiserConfig& n, const std::string& model, int contact_basis, bool global_states,
+               const std::string& representation) {
   n.model = model;
-  n.sample_size = model != "contact" ? 1200 : contact_basis > 0 ? 2 * contact_basis : 2 * kBasisRows;
+  n.sample_size = model != "contact" ? motion_sample_size(representation)
+                  : contact_basis > 0 ? 2 * contact_basis : 2 * kBasisRows;
   n.object_condition_size = object_condition_size(global_states);
   n.contact_condition_size = model == "contact" ? 0 : 2 * kBasisRows;
 }
@@ -93,14 +97,6 @@ at::Generator seed_step(std::uint64_t seed, std::int64_t step, int rank, std::mt
     def.set_current_seed(mix(s, 17));
   }
   return at::detail::createCPUGenerator(mix(s, 29));
-}
-
-std::string fmt_duration(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "?";
-  const long s = static_cast<long>(seconds + 0.5);
-  if (s >= 3600) return std::to_string(s / 3600) + "h" + (s % 3600 / 60 < 10 ? "0" : "") + std::to_string(s % 3600 / 60) + "m";
-  if (s >= 60) return std::to_string(s / 60) + "m" + (s % 60 < 10 ? "0" : "") + std::to_string(s % 60) + "s";
-  return std::to_string(s) + "s";
 }
 
 std::string adam_key(const at::Tensor& p) { return c10::guts::to_string(p.unsafeGetTensorImpl()); }
@@ -199,7 +195,8 @@ TrainConfig load_train_config(const std::string& path) {
     c.text = s.str();
   }
   check_keys(path, root, "the training config",
-             {"model", "data", "out", "export", "export_half", "init", "variant", "stride", "network", "diffusion", "training"});
+             {"model", "data", "out", "export", "export_half", "init", "variant", "representation", "stride", "network",
+              "diffusion", "training"});
   read(path, root, "model", c.model);
   if (c.model != "contact" && c.model != "motion")
     throw Error(where(path, root["model"] ? root["model"] : root) + ": 'model' must be contact or motion");
@@ -210,6 +207,13 @@ TrainConfig load_train_config(const std::string& path) {
   read(path, root, "export_half", c.export_half);
   read(path, root, "init", c.init);
   read(path, root, "variant", c.variant);
+  read(path, root, "representation", c.representation);
+  if (c.representation != kKeypointsRepresentation && c.representation != kManoRepresentation)
+    throw Error(where(path, root["representation"]) + ": 'representation' must be keypoints or mano, got '" +
+                c.representation + "'");
+  if (c.representation == kManoRepresentation && c.model != "motion")
+    throw Error(where(path, root["representation"]) +
+                ": 'representation: mano' is for the motion model only; the contact model samples contact maps");
   read(path, root, "stride", c.stride);
   if (const YAML::Node n = root["network"]) {
     check_keys(path, n, "network",
@@ -257,7 +261,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "validation_windows", c.validation_windows);
     read(path, n, "log_every", c.log_every);
   }
-  set_sizes(c.network, c.model, c.contact_basis, c.global_states);
+  set_sizes(c.network, c.model, c.contact_basis, c.global_states, c.representation);
   try {
     validate(c);
   } catch (const Error& e) {
@@ -274,6 +278,13 @@ void validate(const TrainConfig& c) {
   need(!c.data.empty(), "'data' (the data set folder) is required");
   need(!c.out.empty(), "'out' (the run folder) is required");
   parse_bps_variant(c.variant);
+  check_representation_name(c.representation);
+  need(c.representation == kKeypointsRepresentation || c.model == "motion",
+       "'representation: " + c.representation + "' is for the motion model only; the contact model samples contact maps");
+  if (c.model == "motion")
+    need(c.network.sample_size == motion_sample_size(c.representation),
+         "the motion model's sample size must be " + std::to_string(motion_sample_size(c.representation)) +
+             " for representation " + c.representation + ", got " + std::to_string(c.network.sample_size));
   need(c.stride >= 1, "'stride' must be positive");
   need(c.contact_log_eps >= 0 && std::isfinite(c.contact_log_eps), "'network.contact_log_eps' must be >= 0 (metres)");
   need(c.contact_log_eps == 0 || c.model == "contact", "'network.contact_log_eps' is for the contact model only");
@@ -314,16 +325,21 @@ double learning_rate(const TrainConfig& c, std::int64_t step) {
 
 // ---- one step ----
 
-at::Tensor normalized_sample(const std::string& model, const NormalizationStats& stats, const WindowBatch& b) {
-  return model == "contact" ? stats.contact_sample(b.contact_maps) : stats.normalize_x(b.hand_features);
+at::Tensor normalized_sample(const std::string& model, const std::string& representation,
+                             const NormalizationStats& stats, const WindowBatch& b) {
+  if (model == "contact") return stats.contact_sample(b.contact_maps);
+  if (representation != kManoRepresentation) return stats.normalize_x(b.hand_features);
+  if (!b.mano.defined())
+    throw Error("the batch holds no MANO representation (open the data set with WindowDatasetOptions::mano)");
+  return stats.normalize_mano(b.mano);
 }
 
 StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b,
                             at::Generator gen) {
   StepInputs in;
-  const auto B = b.hand_features.size(0);
+  const auto B = b.mask.size(0);
   in.object = model_object_condition(c.network, stats, b.object_features, b.global_states);
-  in.sample = normalized_sample(c.model, stats, b);
+  in.sample = normalized_sample(c.model, c.representation, stats, b);
   if (c.model == "motion") {
     in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
     in.use_contact = at::rand({B}, gen) >= c.contact_dropout;
@@ -357,7 +373,7 @@ static std::pair<at::Tensor, at::Tensor> fit_gaussian_skip(const TrainConfig& c,
   std::vector<at::Tensor> rows;
   for (std::size_t first = 0; first < idx.size(); first += 128) {
     const auto last = idx.begin() + static_cast<std::ptrdiff_t>(std::min(idx.size(), first + 128));
-    rows.push_back(normalized_sample(c.model, stats, data.batch({idx.begin() + static_cast<std::ptrdiff_t>(first), last})));
+    rows.push_back(normalized_sample(c.model, c.representation, stats, data.batch({idx.begin() + static_cast<std::ptrdiff_t>(first), last})));
   }
   const at::Tensor all = at::cat(rows, 0);  // [n, W, D]; padding repeats the last frame
   auto fit = principal_directions(all.reshape({-1, all.size(-1)}), c.network.skip_rank);
@@ -447,6 +463,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   WindowDatasetOptions wo;
   wo.variant = parse_bps_variant(config.variant);
   wo.stride = config.stride;
+  wo.mano = config.representation == kManoRepresentation;
   std::unique_ptr<ProgressBar> bar;
   wo.progress = [&](std::size_t done, std::size_t total) {
     if (!bar) bar = std::make_unique<ProgressBar>("features", total, show);
@@ -470,6 +487,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   info.diffusion_steps = config.diffusion_steps;
   info.schedule_shift = config.schedule_shift;
   info.variant = config.variant;
+  info.representation = config.representation;
   info.basis_points = train_set.basis_points();
   info.keypoints = posing_keypoint_ids();
   info.normalization = stats;
@@ -486,7 +504,8 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   Denoiser ema_net(config.network);
   if (!config.init.empty() && !options.resume) {
     const Checkpoint ck = load_checkpoint(config.init);
-    check_compatible(ck.info, config.init, config.model, config.variant, info.basis_points, info.keypoints);
+    check_compatible(ck.info, config.init, config.model, config.variant, info.basis_points, info.keypoints,
+                     config.representation);
     const int copied = warm_start(*net, ck.weights);
     if (show) log::info("initialised {} of {} parameters from {}", copied, net->named_parameters().size(), config.init);
   }
@@ -514,7 +533,8 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
       throw Error("--resume: no checkpoint " + checkpoint_path + " to resume from");
     const Checkpoint ck = load_checkpoint(checkpoint_path);
     if (!ck.train) throw Error(checkpoint_path + " holds no training state (an exported model?)");
-    check_compatible(ck.info, checkpoint_path, config.model, config.variant, info.basis_points, info.keypoints);
+    check_compatible(ck.info, checkpoint_path, config.model, config.variant, info.basis_points, info.keypoints,
+                     config.representation);
     if (ck.info.network.describe() != config.network.describe())
       throw Error(checkpoint_path + ": the network differs from the config (" + ck.info.network.describe() +
                   " vs " + config.network.describe() + ")");
@@ -589,7 +609,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
       auto gen = at::detail::createCPUGenerator(static_cast<std::uint64_t>(1000003 + chunk));
       StepInputs in;
       in.object = model_object_condition(config.network, stats, b.object_features, b.global_states);
-      in.sample = normalized_sample(config.model, stats, b);
+      in.sample = normalized_sample(config.model, config.representation, stats, b);
       if (config.model == "motion") in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
       in.mask = b.mask;
       in.noise = at::randn(in.sample.sizes(), gen);
@@ -670,7 +690,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
         const double eta = (config.steps - step) * config.batch * world / std::max(rate, 1e-9);
         std::string v = std::isfinite(r.validation) ? fmt::format("  validation {:.4f}", r.validation) : "";
         log::info("step {}/{}  loss {:.4f}{}  lr {:.2e}  {:.1f} windows/s  {} left", step, config.steps, r.loss, v, lr,
-                  rate, fmt_duration(eta));
+                  rate, format_duration(eta));
       }
       interval_loss = 0;
       interval_steps = 0;

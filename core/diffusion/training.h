@@ -39,6 +39,9 @@ struct TrainConfig {
   // the contact cue) keeps the old ones and gets zeros in the new. "" = random start.
   std::string init;
   std::string variant = "np_bps";
+  // Motion model: what it samples, "keypoints" (X = [H | D], the method) or "mano" (MANO-Rep,
+  // core/diffusion/representation.h). The contact model refuses "mano".
+  std::string representation = "keypoints";
   int stride = 16;         // window stride of the training windows
   DenoiserConfig network;
   // Contact model: > 0 samples C in log space, log(C + contact_log_eps) normalised (metres;
@@ -110,7 +113,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options);
 // One optimisation target, separated from data loading so that tests (and several
 // processes) can feed explicit batches: the loss of a batch with given noise and steps.
 struct StepInputs {
-  at::Tensor sample;     // [B, T, S] normalised clean sample (C or X)
+  at::Tensor sample;     // [B, T, S] normalised clean sample (C, X or MANO-Rep)
   at::Tensor object;     // [B, T, 3079] normalised [O | G], or [B, T, 3072] O (w/o G)
   at::Tensor contact;    // [B, T, 2048] normalised C (motion model) or undefined
   at::Tensor use_contact;  // [B] bool (motion model) or undefined
@@ -118,14 +121,16 @@ struct StepInputs {
   at::Tensor noise;      // [B, T, S]
   at::Tensor t;          // [B] int64
 };
-// What a model denoises, normalised: the contact maps C [B, T, 2048] ("contact") or the
-// hand features X [B, T, 1200] ("motion") of a batch.
 // Copies `weights` into net's parameters of the same name (TrainConfig::init): equal
 // shapes as they are; a 2-D weight with more columns here gets the old columns and zeros.
 // Others are left as they are, with a warning. Returns the number copied.
 int warm_start(torch::nn::Module& net, const std::map<std::string, at::Tensor>& weights);
 
-at::Tensor normalized_sample(const std::string& model, const NormalizationStats& stats, const WindowBatch& batch);
+// What a model denoises, normalised: the contact maps C [B, T, 2048] ("contact"), or for
+// "motion" the hand features X [B, T, 1200] (representation "keypoints") or MANO-Rep
+// [B, T, 294] ("mano") of a batch.
+at::Tensor normalized_sample(const std::string& model, const std::string& representation,
+                             const NormalizationStats& stats, const WindowBatch& batch);
 // Builds StepInputs from a batch: normalisation, and noise, steps and contact dropout
 // drawn from `gen`.
 StepInputs make_step_inputs(const TrainConfig& config, const NormalizationStats& stats,

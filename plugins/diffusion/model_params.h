@@ -73,6 +73,24 @@ inline void check_contact_model(const diffusion::DiffusionModel& motion, const d
                 contact.path() + " (" + row(contact.info()) + "): use models trained alike");
 }
 
+// The contact condition of a motion stage: one map per sample when the contact stage drew
+// as many, else the one map, else (use_contact off) none. Refuses maps of a contact model
+// of another row (check_contact_model) when they come from it.
+inline at::Tensor contact_condition(const diffusion::DiffusionModel& motion, const diffusion::GenerateOptions& options,
+                                    StageIO& io, const std::string& stage) {
+  if (!options.use_contact) return {};
+  const char* port = io.has("contact_maps_samples") &&
+                             io.in<at::Tensor>("contact_maps_samples").size(0) == options.samples
+                         ? "contact_maps_samples"
+                         : "contact_maps";
+  if (!io.has(port))
+    throw Error(stage + ": use_contact is on but no contact_maps are wired (set use_contact: false for the null token)");
+  // The maps' own model only (a pipeline may hold other contact stages).
+  if (io.has("contact_model") && io.source("contact_model") == io.source(port))
+    check_contact_model(motion, *diffusion::DiffusionModel::load(io.in<std::string>("contact_model")));
+  return io.in<at::Tensor>(port);
+}
+
 // libtorch generator seeded from the stage's own seeded stream.
 inline at::Generator stage_generator(StageIO& io) { return at::detail::createCPUGenerator(io.rng()()); }
 

@@ -5,6 +5,7 @@
 
 #include <chrono>
 
+#include "core/diffusion/representation.h"
 #include "core/pipeline/plugin.h"
 #include "core/util/log.h"
 #include "model_params.h"
@@ -34,28 +35,18 @@ class MotionDiffusion : public MotionGenerator {
     s_.options.use_contact = p.boolean("use_contact");
     if (s_.model->info().network.model != "motion")
       throw Error(s_.model->path() + " is a " + s_.model->info().network.model + " model, not a motion model");
+    if (s_.model->info().representation != diffusion::kKeypointsRepresentation)
+      throw Error("motion.diffusion samples keypoints X = [H | D], but " + s_.model->path() + " samples " +
+                  diffusion::describe_representation(s_.model->info().representation) +
+                  ": use motion.diffusion_mano for it");
     diffusion::check_compatible(s_.model->info(), s_.model->path(), "motion", "", {},
-                                diffusion::posing_keypoint_ids());
+                                diffusion::posing_keypoint_ids(), diffusion::kKeypointsRepresentation);
   }
 
   void run(StageIO& io) override {
     const auto t0 = std::chrono::steady_clock::now();
     diffusion_plugin::check_encoder(*s_.model, io);
-    // The maps' own model only (a pipeline may hold other contact stages).
-    const auto maps_port = io.has("contact_maps_samples") ? "contact_maps_samples" : "contact_maps";
-    if (s_.options.use_contact && io.has("contact_model") && io.has(maps_port) &&
-        io.source("contact_model") == io.source(maps_port))
-      diffusion_plugin::check_contact_model(*s_.model, *diffusion::DiffusionModel::load(io.in<std::string>("contact_model")));
-    at::Tensor C;
-    if (s_.options.use_contact) {
-      if (io.has("contact_maps_samples") && io.in<at::Tensor>("contact_maps_samples").size(0) == s_.options.samples)
-        C = io.in<at::Tensor>("contact_maps_samples");
-      else if (io.has("contact_maps"))
-        C = io.in<at::Tensor>("contact_maps");
-      else
-        throw Error("motion.diffusion: use_contact is on but no contact_maps are wired (set use_contact: false for "
-                    "the null token)");
-    }
+    const at::Tensor C = diffusion_plugin::contact_condition(*s_.model, s_.options, io, "motion.diffusion");
     const Guidance* guidance = nullptr;
     if (io.has("guidance")) guidance = io.in<std::shared_ptr<const Guidance>>("guidance").get();
     const at::Tensor X = s_.model->generate(io.in<at::Tensor>("object_features"), io.in<at::Tensor>("global_states"), C,

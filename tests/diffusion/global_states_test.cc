@@ -85,11 +85,6 @@ TEST(GlobalStates, ConfigSwitchSetsTheObjectConditionWidth) {
   TrainConfig odd = c;
   odd.global_states = true;
   EXPECT_NE(error_of([&] { validate(odd); }).find("global_states"), std::string::npos);
-  // The shipped Table 3 configs.
-  const std::string root = BIMART_SOURCE_DIR;
-  EXPECT_FALSE(load_train_config(root + "/models/table3/no_g_contact.yaml").global_states);
-  EXPECT_FALSE(load_train_config(root + "/models/table3/no_g_motion.yaml").global_states);
-  EXPECT_TRUE(load_train_config(root + "/models/table3/u_bps_motion.yaml").global_states);
 }
 
 TEST(GlobalStates, TrainingFeedsAModelWithoutGOnlyO) {

@@ -296,5 +296,17 @@ TEST(SweepFile, InlineModelsAndRowSelection) {
   EXPECT_EQ(f.rows[0].name, "b");
 }
 
+TEST(SweepFile, TheShippedTable3HasEveryRowWithThePapersNumbers) {
+  const sweep::SweepFile f = sweep::SweepFile::load(std::string(BIMART_SOURCE_DIR) + "/pipelines/sweeps/table3.yaml");
+  std::vector<std::string> names;
+  for (const auto& r : f.rows) names.push_back(r.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"GT", "U-BPS", "NPA-BPS", "MANO-Rep", "NP-BPS w/o G", "NP-BPS", "w/o C",
+                                             "w C", "w C + CG", "w C + CG + Opt"}));
+  EXPECT_DOUBLE_EQ(f.rows[4].paper.at("Accel"), 0.28233);
+  EXPECT_DOUBLE_EQ(f.rows[9].paper.at("Pen 1cm"), 2.0346);
+  EXPECT_EQ(f.base.limit, 100);
+  EXPECT_EQ(f.base.samples, 10);
+}
+
 }  // namespace
 }  // namespace bimart
