@@ -3,12 +3,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 
 #include <nlohmann/json.hpp>
 
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
+#include "core/util/fingerprint.h"
 #include "core/util/text.h"
 
 namespace bimart {
@@ -166,6 +168,21 @@ std::vector<std::string> split_files(const DatasetManifest& m, const std::string
   out.reserve(list->size());
   for (const std::string& f : *list) out.push_back((fs::path(folder) / f).lexically_normal().string());
   return out;
+}
+
+std::string dataset_fingerprint(const std::string& folder) {
+  const DatasetManifest m = read_manifest(folder);
+  std::ifstream in(fs::path(folder) / "manifest.json", std::ios::binary);
+  const std::string manifest_text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Fnv f;
+  f.add(manifest_text);
+  for (const auto* split : {&m.train, &m.test})
+    for (const auto& name : *split) {
+      std::error_code ec;
+      f.add(name);
+      f.add_value(static_cast<std::uint64_t>(fs::file_size(fs::path(folder) / name, ec)));
+    }
+  return f.hex();
 }
 
 }  // namespace bimart

@@ -49,4 +49,9 @@ void write_manifest(const DatasetManifest& m, const std::string& folder);
 // unknown split throws bimart::Error listing the known ones.
 std::vector<std::string> split_files(const DatasetManifest& m, const std::string& folder, const std::string& split);
 
+// The data set's fingerprint (stored in checkpoints, part of sweep job keys): its manifest's
+// text and every listed file's name (relative to the folder) and size. Independent of how
+// the folder's path is spelled.
+std::string dataset_fingerprint(const std::string& folder);
+
 }  // namespace bimart

@@ -395,27 +395,6 @@ StepInputs draw_step(const TrainConfig& config, const NormalizationStats& stats,
   return make_step_inputs(config, stats, data.sample_batch(config.batch, rng), gen);
 }
 
-std::string data_fingerprint(const std::string& folder) {
-  std::uint64_t h = 1469598103934665603ULL;
-  const auto feed = [&](const std::string& s) {
-    for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ULL;
-  };
-  const fs::path manifest = fs::path(folder) / "manifest.json";
-  std::ifstream in(manifest, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  feed(text.str());
-  const DatasetManifest m = read_manifest(folder);
-  for (const auto& f : split_files(m, folder, "train")) {
-    std::error_code ec;
-    feed(f);
-    feed(std::to_string(fs::file_size(f, ec)));
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
-
 int warm_start(torch::nn::Module& net, const std::map<std::string, at::Tensor>& weights) {
   torch::NoGradGuard ng;
   int copied = 0;
@@ -492,7 +471,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   info.keypoints = posing_keypoint_ids();
   info.normalization = stats;
   info.config_text = config.text;
-  info.data_fingerprint = data_fingerprint(config.data);
+  info.data_fingerprint = dataset_fingerprint(config.data);
 
   // Networks: the trained one and its EMA copy (used for validation and sampling).
   // Initialisation draws from libtorch's global generator: one training at a time seeds

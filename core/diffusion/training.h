@@ -148,8 +148,4 @@ struct LossParts {
 };
 LossParts step_loss(Denoiser& net, const struct NoiseSchedule& schedule, const StepInputs& in);
 
-// A data fingerprint: FNV-1a over the manifest and the size and modification time of
-// each training sequence file, as 16 hex digits.
-std::string data_fingerprint(const std::string& folder);
-
 }  // namespace bimart::diffusion

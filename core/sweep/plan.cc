@@ -252,19 +252,6 @@ const char* job_kind_name(JobKind kind) {
   return "?";
 }
 
-std::string dataset_fingerprint(const std::string& folder) {
-  const DatasetManifest m = read_manifest(folder);
-  Fnv f;
-  f.add(read_text((fs::path(folder) / "manifest.json").string(), "the data set manifest"));
-  for (const auto* split : {&m.train, &m.test})
-    for (const auto& name : *split) {
-      std::error_code ec;
-      f.add(name);
-      f.add_value(static_cast<std::uint64_t>(fs::file_size(fs::path(folder) / name, ec)));
-    }
-  return f.hex();
-}
-
 Plan make_plan(const SweepFile& file, const std::string& dir) {
   Planner p{file, {}, {}, {}, {}, {}, {}};
   p.plan.sweep_file = file.path;

@@ -56,8 +56,4 @@ struct Plan {
 // windows (for estimates; 0 = read from the data set).
 Plan make_plan(const SweepFile& file, const std::string& dir);
 
-// The data set's fingerprint: its manifest and every listed file's name (relative to the
-// folder) and size. Independent of how the folder's path is spelled.
-std::string dataset_fingerprint(const std::string& folder);
-
 }  // namespace bimart::sweep

@@ -20,6 +20,7 @@
 #include "core/io/npz.h"
 #include "core/util/error.h"
 #include "tests/data/tiny_dataset.h"
+#include "tests/diffusion/tiny_train_config.h"
 #include "tests/error_of.h"
 
 using bimart::test::error_of;
@@ -37,23 +38,12 @@ fs::path scratch(const std::string& name) {
 }
 
 TrainConfig tiny(const fs::path& out, const std::string& model, bool global_states) {
-  TrainConfig c;
-  c.model = model;
-  c.data = testing_data::tiny_dataset().dir.string();
-  c.out = out.string();
+  TrainConfig c = tiny_train_config(out, model);
   c.global_states = global_states;
-  c.network = DenoiserConfig::paper(model);
   c.network.object_condition_size = object_condition_size(global_states);
-  c.network.latent = 16;
-  c.network.layers = 1;
-  c.network.heads = 2;
-  c.network.feedforward = 32;
-  c.network.condition_hidden = 16;
-  c.batch = 3;
   c.steps = 3;
   c.lr = 1e-2;
   c.warmup = 1;
-  c.checkpoint_every = 3;
   c.validate_every = 0;
   c.seed = 7;
   return c;

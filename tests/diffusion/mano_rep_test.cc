@@ -24,6 +24,7 @@
 #include "core/util/error.h"
 #include "tests/cli/run_bimart.h"
 #include "tests/data/tiny_dataset.h"
+#include "tests/diffusion/tiny_train_config.h"
 #include "tests/error_of.h"
 
 namespace bimart::diffusion {
@@ -50,24 +51,13 @@ int exit_code(const test::CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(
 test::CliRun bimart_in_source(const std::string& args) { return test::run_bimart("-q " + args); }
 
 TrainConfig tiny_mano_config(const fs::path& out) {
-  TrainConfig c;
-  c.model = "motion";
+  TrainConfig c = tiny_train_config(out, "motion");
   c.representation = kManoRepresentation;
-  c.data = testing_data::tiny_dataset().dir.string();
-  c.out = out.string();
   c.export_path = (out / "model.npz").string();
-  c.network = DenoiserConfig::paper("motion");
   c.network.sample_size = kManoRepSize;
-  c.network.latent = 16;
-  c.network.layers = 1;
-  c.network.heads = 2;
-  c.network.feedforward = 32;
-  c.network.condition_hidden = 16;
-  c.batch = 3;
   c.steps = 3;
   c.lr = 1e-3;
   c.warmup = 1;
-  c.checkpoint_every = 3;
   c.validate_every = 3;
   c.validation_windows = 2;
   c.log_every = 1;

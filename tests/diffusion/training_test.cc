@@ -20,6 +20,7 @@
 #include "core/diffusion/training.h"
 #include "core/util/error.h"
 #include "tests/data/tiny_dataset.h"
+#include "tests/diffusion/tiny_train_config.h"
 #include "tests/error_of.h"
 
 namespace bimart::diffusion {
@@ -35,22 +36,11 @@ fs::path scratch(const std::string& name) {
 }
 
 TrainConfig tiny_config(const fs::path& out, const std::string& model = "motion") {
-  TrainConfig c;
-  c.model = model;
-  c.data = testing_data::tiny_dataset().dir.string();
-  c.out = out.string();
-  c.network = DenoiserConfig::paper(model);
-  c.network.latent = 16;
-  c.network.layers = 1;
-  c.network.heads = 2;
-  c.network.feedforward = 32;
-  c.network.condition_hidden = 16;
+  TrainConfig c = tiny_train_config(out, model);
   c.network.dropout = 0.1;
-  c.batch = 3;
   c.steps = 6;
   c.lr = 1e-3;
   c.warmup = 2;
-  c.checkpoint_every = 3;
   c.validate_every = 3;
   c.validation_windows = 4;
   c.log_every = 1;
