@@ -15,6 +15,7 @@ packages=(
   python3 python3-numpy                              # tools/ converters (numpy only)
   blender chromium                                   # output tests: glTF import, viewer page (docs/outputs.md)
   gnuplot-nox                                        # bimart sweep's table picture (docs/sweeps.md)
+  slurm-wlm munge                                    # bimart sweep --backend slurm; its test starts a one-machine cluster (docs/cluster.md)
 )
 
 missing=()

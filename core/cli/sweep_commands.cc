@@ -1,6 +1,7 @@
 // bimart sweep SWEEP.yaml: trains the models a sweep's rows need, generates and evaluates
 // every row on the same evaluation windows, and writes the table beside the paper's
-// (core/sweep/, docs/sweeps.md). bimart sweep status DIR: what is done, running, left.
+// (core/sweep/, docs/sweeps.md) on this machine or a Slurm cluster (docs/cluster.md).
+// bimart sweep status DIR: what is done, running, left. bimart sweep job DIR KEY: one job.
 #include <fcntl.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -15,9 +16,11 @@
 
 #include "core/cli/command.h"
 #include "core/cli/common_options.h"
+#include "core/sweep/job_runner.h"
 #include "core/sweep/job_state.h"
 #include "core/sweep/local_backend.h"
 #include "core/sweep/plan.h"
+#include "core/sweep/slurm_backend.h"
 #include "core/sweep/sweep_file.h"
 #include "core/sweep/table.h"
 #include "core/util/error.h"
@@ -33,6 +36,12 @@ struct SweepArgs {
   std::string file, out, rows, backend = "local", status_dir;
   bool dry_run = false;
   int jobs = 1;
+  // --backend slurm
+  std::string partition, account, time_limit, sbatch_args, bimart;
+  int cpus_per_task = 0;
+  bool detach = false;
+  // bimart sweep job DIR KEY
+  std::string job_dir, job_key;
   double report_every = 30;
   double lock_wait = 60;
 };
@@ -82,9 +91,29 @@ std::string job_state_text(const Job& job, bool needed) {
   if (!needed) return "not needed (what it feeds is done)";
   const Progress p = read_progress(job);
   std::string s = fs::exists(job.folder) ? "started" : "to run";
-  if (job.kind == JobKind::Train && fs::exists(fs::path(job.folder) / "checkpoint.npz")) s = "checkpointed";
+  if (resumes_checkpoint(job)) s = "checkpointed";
   if (p.known) s += fmt::format(" ({} {:.0f}/{:.0f})", p.label, p.done, p.total);
   return s;
+}
+
+// ", Slurm job 4711 RUNNING on n12" for a job submitted to Slurm; "" otherwise.
+std::string slurm_text(const Job& job, const std::map<long, SlurmJobState>& queue) {
+  const long id = submitted_id(job);
+  if (id <= 0) return "";
+  const auto it = queue.find(id);
+  if (it == queue.end()) return fmt::format(", Slurm job {} (no longer in squeue)", id);
+  const SlurmJobState& q = it->second;
+  std::string s = fmt::format(", Slurm job {} {}", id, q.state);
+  if (q.state == "PENDING" && !q.reason.empty() && q.reason != "None") s += " (" + q.reason + ")";
+  if (q.state == "RUNNING" && !q.nodes.empty()) s += " on " + q.nodes;
+  return s;
+}
+
+std::vector<std::string> split_spaces(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string p; ss >> p;) out.push_back(p);
+  return out;
 }
 
 void print_plan(const Plan& plan, int jobs, int threads) {
@@ -114,8 +143,10 @@ void print_plan(const Plan& plan, int jobs, int threads) {
 
 int run_sweep(const SweepArgs& a) {
   if (a.file.empty()) throw Error("bimart sweep needs a sweep file (bimart sweep SWEEP.yaml) or 'status DIR'");
-  if (a.backend != "local")
-    throw Error("--backend " + a.backend + ": unknown backend (known: local)");
+  if (a.backend != "local" && a.backend != "slurm")
+    throw Error("--backend " + a.backend + ": unknown backend (known: local, slurm)");
+  if (a.backend == "slurm" && !a.dry_run && !slurm_available())
+    throw Error("--backend slurm: sbatch is not on PATH (run on a machine of the cluster; docs/cluster.md)");
   SweepFile file = SweepFile::load(a.file);
   file.select_rows(split_commas(a.rows));
   const std::string dir = a.out.empty() ? (fs::path("out") / "sweeps" / file.name).string() : a.out;
@@ -128,12 +159,28 @@ int run_sweep(const SweepArgs& a) {
   }
   const int lock = lock_folder(dir, a.lock_wait);
   write_plan_json(plan);
-  LocalOptions lo;
-  lo.jobs = a.jobs;
-  lo.threads = threads;
-  lo.report_every = a.report_every;
-  lo.quiet = common_options().quiet > 0;
-  const RunSummary s = run_local(plan, lo);
+  RunSummary s;
+  if (a.backend == "slurm") {
+    SlurmOptions so;
+    so.partition = a.partition;
+    so.account = a.account;
+    so.time_limit = a.time_limit;
+    so.sbatch_args = split_spaces(a.sbatch_args);
+    so.program = a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string();
+    so.cpus_per_task = a.cpus_per_task;
+    so.wait = !a.detach;
+    so.report_every = a.report_every;
+    so.quiet = common_options().quiet > 0;
+    s = run_slurm(plan, so);
+  } else {
+    LocalOptions lo;
+    lo.jobs = a.jobs;
+    lo.threads = threads;
+    lo.program = a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string();
+    lo.report_every = a.report_every;
+    lo.quiet = common_options().quiet > 0;
+    s = run_local(plan, lo);
+  }
   const TableFiles t = write_table(plan);
   ::close(lock);
   std::ifstream md(fs::path(dir) / "table.md");
@@ -142,6 +189,10 @@ int run_sweep(const SweepArgs& a) {
   if (!t.picture_note.empty()) std::cout << t.picture_note << "\n";
   std::cout << fmt::format("sweep {}: {} jobs ran, {} were done before, {} failed, {} skipped, {}\n", plan.name, s.ran,
                            s.already_done, s.failed, s.skipped, format_duration(s.seconds));
+  if (s.pending > 0)
+    std::cout << fmt::format("{} job{} in Slurm's queue: bimart sweep status {} follows them; run the same command "
+                             "again to wait for them\n",
+                             s.pending, s.pending == 1 ? " is" : "s are", dir);
   if (s.interrupted) {
     std::cout << "interrupted: run the same command again to continue\n";
     return kExitInterrupted;
@@ -154,13 +205,31 @@ int run_status(const std::string& dir) {
   const bool running = folder_locked(dir);
   std::cout << fmt::format("sweep {} in {} ({}): {}\n", plan.name, dir, plan.sweep_file,
                            running ? "a sweep is running" : "no sweep is running");
+  // What Slurm says of the jobs that were submitted to it.
+  std::map<long, SlurmJobState> queue;
+  bool submitted = false;
+  for (const Job& j : plan.jobs) submitted = submitted || submitted_id(j) > 0;
+  if (submitted) {
+    try {
+      queue = slurm_jobs();
+    } catch (const Error& e) {
+      std::cout << "(cannot ask Slurm: " << e.what() << ")\n";
+    }
+  }
   int done = 0;
   const std::vector<bool> needed = needed_jobs(plan);
   for (std::size_t i = 0; i < plan.jobs.size(); ++i) {
     const Job& j = plan.jobs[i];
     done += !needed[i];
-    std::cout << fmt::format("  {:>2}. {:<8} {:<34} {}  {}\n", i + 1, job_kind_name(j.kind), j.name, j.key,
-                             job_state_text(j, needed[i]));
+    const std::string slurm = needed[i] ? slurm_text(j, queue) : "";
+    std::cout << fmt::format("  {:>2}. {:<8} {:<34} {}  {}{}\n", i + 1, job_kind_name(j.kind), j.name, j.key,
+                             job_state_text(j, needed[i]), slurm);
+    // A Slurm job that ended without finishing: the end of its log says why.
+    const long id = submitted_id(j);
+    if (needed[i] && id > 0 && !(queue.count(id) && slurm_state_live(queue.at(id).state))) {
+      std::istringstream tail(log_tail(j, 3));
+      for (std::string line; std::getline(tail, line);) std::cout << "        | " << line << "\n";
+    }
   }
   std::cout << fmt::format("{} of {} jobs done\n\n", done, plan.jobs.size());
   std::cout << table_markdown(plan, collect_table(plan));
@@ -180,7 +249,17 @@ void add_sweep_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--jobs", a.jobs, "jobs side by side; the threads are divided between them")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
-  cmd->add_option("--backend", a.backend, "where jobs run: local")->capture_default_str();
+  cmd->add_option("--backend", a.backend, "where jobs run: local (this machine) or slurm (docs/cluster.md)")
+      ->capture_default_str();
+  cmd->add_option("--partition", a.partition, "slurm: sbatch --partition");
+  cmd->add_option("--account", a.account, "slurm: sbatch --account");
+  cmd->add_option("--time", a.time_limit, "slurm: sbatch --time, each job's time limit (e.g. 12:00:00)");
+  cmd->add_option("--cpus-per-task", a.cpus_per_task,
+                  "slurm: CPUs (threads) of each job whose model sets no cpus_per_task (0 = Slurm's default)")
+      ->check(CLI::Range(0, 4096));
+  cmd->add_option("--sbatch-args", a.sbatch_args, "slurm: more sbatch options, e.g. \"--qos=high --mem=8G\"");
+  cmd->add_flag("--detach", a.detach, "slurm: submit and return; the jobs run on (bimart sweep status follows them)");
+  cmd->add_option("--bimart", a.bimart, "the bimart program the jobs run (default: this one)");
   cmd->add_option("--report-every", a.report_every, "seconds between progress lines of a running job")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
@@ -189,9 +268,20 @@ void add_sweep_commands(CLI::App& app, Commands& out) {
       ->capture_default_str();
   CLI::App* status = cmd->add_subcommand("status", "what a sweep folder holds: each job's state, the table so far");
   status->add_option("dir", a.status_dir, "the sweep's folder")->required()->check(CLI::ExistingDirectory);
+  CLI::App* job = cmd->add_subcommand(
+      "job", "run one job of a planned sweep to its end (what the backends start; docs/sweeps.md)");
+  job->add_option("dir", a.job_dir, "the sweep's folder (holds plan.json)")->required()->check(CLI::ExistingDirectory);
+  job->add_option("key", a.job_key, "the job's key (bimart sweep status DIR lists them)")->required();
   cmd->require_subcommand(0, 1);
-  out.push_back({cmd, [cmd, status] {
+  out.push_back({cmd, [cmd, status, job] {
                    if (status->parsed()) return run_status(a.status_dir);
+                   if (job->parsed()) {
+                     JobRunOptions jo;
+                     jo.program = a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string();
+                     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+                     jo.threads = common_options().threads > 0 ? common_options().threads : cores;
+                     return run_job(read_plan_json(a.job_dir), a.job_key, jo);
+                   }
                    (void)cmd;
                    return run_sweep(a);
                  }});

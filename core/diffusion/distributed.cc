@@ -5,6 +5,7 @@
 
 #include <ATen/ATen.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 
@@ -19,18 +20,36 @@ struct DataParallel::Impl {
 
 namespace {
 
-int env_int(const char* name, int fallback, bool required, int lo, int hi) {
+const char* env(const char* name) {
   const char* v = std::getenv(name);
-  if (v == nullptr || *v == '\0') {
-    if (required) throw Error(std::string("distributed training: ") + name + " is not set");
-    return fallback;
-  }
+  return v != nullptr && *v != '\0' ? v : nullptr;
+}
+
+int parse_int(const char* name, const char* v, int lo, int hi) {
   char* end = nullptr;
   const long x = std::strtol(v, &end, 10);
   if (end == v || *end != '\0' || x < lo || x > hi)
     throw Error(std::string("distributed training: ") + name + "='" + v + "' is not a whole number in [" +
                 std::to_string(lo) + ", " + std::to_string(hi) + "]");
   return static_cast<int>(x);
+}
+
+// The torch variable, else the Slurm one, else an error naming both.
+int torch_or_slurm(const char* torch_name, const char* slurm_name, bool in_slurm, int lo, int hi) {
+  if (const char* v = env(torch_name)) return parse_int(torch_name, v, lo, hi);
+  if (in_slurm)
+    if (const char* v = env(slurm_name)) return parse_int(slurm_name, v, lo, hi);
+  throw Error(std::string("distributed training: ") + torch_name + " is not set" +
+              (in_slurm ? std::string(" (nor ") + slurm_name + ")" : std::string()));
+}
+
+// A Gloo device that reaches the other processes: loopback for a master on this machine,
+// else the interface GLOO_SOCKET_IFNAME names, else the address this host's name resolves to.
+std::shared_ptr<::gloo::transport::Device> gloo_device(const std::string& master_addr) {
+  if (master_addr == "127.0.0.1" || master_addr == "localhost")
+    return ::c10d::ProcessGroupGloo::createDeviceForHostname(master_addr);
+  if (const char* ifname = env("GLOO_SOCKET_IFNAME")) return ::c10d::ProcessGroupGloo::createDeviceForInterface(ifname);
+  return ::c10d::ProcessGroupGloo::createDefaultDevice();
 }
 
 void wait(const c10::intrusive_ptr<::c10d::Work>& work, const char* what) {
@@ -57,7 +76,7 @@ DataParallel::DataParallel(const DataParallelOptions& o) : options_(o), impl_(st
     so.timeout = timeout;
     impl_->store = c10::make_intrusive<::c10d::TCPStore>(o.master_addr, so);
     auto go = c10::make_intrusive<::c10d::ProcessGroupGloo::Options>(timeout);
-    go->devices.push_back(::c10d::ProcessGroupGloo::createDeviceForHostname(o.master_addr));
+    go->devices.push_back(gloo_device(o.master_addr));
     impl_->group = c10::make_intrusive<::c10d::ProcessGroupGloo>(impl_->store, o.rank, o.world_size, go);
   } catch (const Error&) {
     throw;
@@ -70,17 +89,63 @@ DataParallel::DataParallel(const DataParallelOptions& o) : options_(o), impl_(st
 
 DataParallel::~DataParallel() = default;
 
-std::shared_ptr<DataParallel> DataParallel::from_environment() {
-  const int world = env_int("WORLD_SIZE", 1, false, 1, 65536);
-  if (world == 1) return nullptr;
+std::string first_slurm_host(const std::string& nodelist) {
+  // The first entry (commas inside brackets separate numbers, not hosts), then each
+  // bracket group replaced by its first number: "r[2-3]n[01-04]" -> "r2n01".
+  std::string first;
+  int depth = 0;
+  for (const char c : nodelist) {
+    if (c == ',' && depth == 0) break;
+    depth += c == '[' ? 1 : c == ']' ? -1 : 0;
+    first += c;
+  }
+  std::string host;
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    if (first[i] != '[') {
+      host += first[i];
+      continue;
+    }
+    const std::size_t close = first.find(']', i);
+    std::size_t n = i + 1;
+    while (n < first.size() && std::isdigit(static_cast<unsigned char>(first[n]))) ++n;
+    if (close == std::string::npos || n == i + 1)
+      throw Error("distributed training: cannot read the Slurm node list '" + nodelist + "'");
+    host += first.substr(i + 1, n - i - 1);
+    i = close;
+  }
+  if (host.empty()) throw Error("distributed training: the Slurm node list is empty");
+  return host;
+}
+
+std::optional<DataParallelOptions> DataParallel::options_from_environment() {
+  // Inside an srun step of several tasks; a batch script (no step) is one process.
+  const char* step_tasks = env("SLURM_STEP_NUM_TASKS");
+  const bool in_slurm = step_tasks != nullptr && parse_int("SLURM_STEP_NUM_TASKS", step_tasks, 1, 65536) > 1;
+  if (env("WORLD_SIZE") == nullptr && !in_slurm) return std::nullopt;
   DataParallelOptions o;
-  o.world_size = world;
-  o.rank = env_int("RANK", 0, true, 0, world - 1);
-  const char* addr = std::getenv("MASTER_ADDR");
-  if (addr == nullptr || *addr == '\0') throw Error("distributed training: MASTER_ADDR is not set");
-  o.master_addr = addr;
-  o.master_port = env_int("MASTER_PORT", 29500, true, 1, 65535);
-  return std::make_shared<DataParallel>(o);
+  o.world_size = torch_or_slurm("WORLD_SIZE", "SLURM_STEP_NUM_TASKS", in_slurm, 1, 65536);
+  if (o.world_size == 1) return std::nullopt;
+  o.rank = torch_or_slurm("RANK", "SLURM_PROCID", in_slurm, 0, o.world_size - 1);
+  if (const char* addr = env("MASTER_ADDR")) {
+    o.master_addr = addr;
+  } else if (in_slurm && (env("SLURM_STEP_NODELIST") || env("SLURM_JOB_NODELIST"))) {
+    o.master_addr = first_slurm_host(env("SLURM_STEP_NODELIST") ? env("SLURM_STEP_NODELIST") : env("SLURM_JOB_NODELIST"));
+  } else {
+    throw Error(std::string("distributed training: MASTER_ADDR is not set") +
+                (in_slurm ? " (nor SLURM_STEP_NODELIST)" : ""));
+  }
+  if (env("MASTER_PORT") == nullptr && in_slurm && env("SLURM_JOB_ID") != nullptr) {
+    // One port per job, so two jobs' ranks on a node do not meet.
+    o.master_port = 15000 + parse_int("SLURM_JOB_ID", env("SLURM_JOB_ID"), 0, 2147483647) % 20000;
+  } else {
+    o.master_port = torch_or_slurm("MASTER_PORT", "SLURM_JOB_ID", false, 1, 65535);
+  }
+  return o;
+}
+
+std::shared_ptr<DataParallel> DataParallel::from_environment() {
+  const auto o = options_from_environment();
+  return o ? std::make_shared<DataParallel>(*o) : nullptr;
 }
 
 namespace {

@@ -38,6 +38,8 @@ double default_rate(const Job& job) {
 
 }  // namespace
 
+json read_json_or_empty(const std::string& path) { return read_json(path); }
+
 std::string done_file(const Job& job) { return (fs::path(job.folder) / "done.json").string(); }
 std::string log_file(const Job& job) { return (fs::path(job.folder) / "log.txt").string(); }
 std::string progress_file(const Job& job) { return (fs::path(job.folder) / "progress.json").string(); }
@@ -145,7 +147,8 @@ void write_plan_json(const Plan& plan) {
                          {"rate_key", job.rate_key},
                          {"nodes", job.nodes},
                          {"tasks_per_node", job.tasks_per_node},
-                         {"cpus_per_task", job.cpus_per_task}});
+                         {"cpus_per_task", job.cpus_per_task},
+                         {"config", job.config_text}});
   j["rows"] = json::array();
   for (const auto& r : plan.rows)
     j["rows"].push_back({{"name", r.name},
@@ -182,6 +185,7 @@ Plan read_plan_json(const std::string& dir) {
     job.nodes = o.value("nodes", 1);
     job.tasks_per_node = o.value("tasks_per_node", 1);
     job.cpus_per_task = o.value("cpus_per_task", 0);
+    job.config_text = o.value("config", std::string());
     plan.jobs.push_back(job);
   }
   for (const auto& o : j.value("rows", json::array())) {

@@ -24,6 +24,8 @@ bool is_done(const Job& job);
 // bulky outputs were deleted (or never copied) reruns nothing that is not missing.
 std::vector<bool> needed_jobs(const Plan& plan);
 
+// A JSON file's content ({} when absent or unreadable).
+nlohmann::json read_json_or_empty(const std::string& path);
 // done.json's content ({} when absent or unreadable).
 nlohmann::json read_done(const Job& job);
 // Writes done.json: the key, seconds, threads, work and rate (work units per second).

@@ -8,15 +8,14 @@
 #include <chrono>
 #include <csignal>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "core/sweep/job_runner.h"
 #include "core/sweep/job_state.h"
-#include "core/util/atomic_file.h"
 #include "core/util/error.h"
 #include "core/util/text.h"
 
@@ -35,46 +34,23 @@ struct Running {
   pid_t pid = -1;
   int threads = 1;
   Clock::time_point started, last_report;
-  // Progress of the current phase (its label): the first reading and the last, and when.
+  // Progress of the current phase (its label): the first reading, and when.
   std::string label;
-  double first_done = -1, last_done = -1, total = 0;
-  Clock::time_point first_seen, last_seen;
+  double first_done = -1;
+  Clock::time_point first_seen;
 };
 
-std::string self_program() {
-  std::error_code ec;
-  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw Error("cannot find this program's path (/proc/self/exe): " + ec.message());
-  return p.string();
-}
-
-std::vector<std::string> command_of(const Job& job, const std::string& program, int threads) {
-  std::vector<std::string> argv{program, "--threads", std::to_string(threads)};
-  argv.insert(argv.end(), job.args.begin(), job.args.end());
-  if (job.kind == JobKind::Train && fs::exists(fs::path(job.folder) / "checkpoint.npz")) argv.push_back("--resume");
-  return argv;
-}
-
-pid_t launch(const Job& job, const std::vector<std::string>& argv) {
+// `program --threads T sweep job DIR KEY` (core/sweep/job_runner.h) with its output in the
+// job's log; the runner runs the job's command, forwards SIGTERM and marks the job done.
+pid_t launch(const Plan& plan, const Job& job, const std::string& program, int threads) {
   fs::create_directories(job.folder);
-  fs::remove(progress_file(job));  // an earlier run's
-  if (job.kind == JobKind::Train)
-    write_file_atomically((fs::path(job.folder) / "config.yaml").string(), [&](std::ostream& o) { o << job.config_text; });
   const std::string log = log_file(job);
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (fd < 0) throw Error("cannot write " + log + ": " + std::strerror(errno));
-  {
-    const std::time_t now = std::time(nullptr);
-    char when[32];
-    std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S", std::localtime(&now));
-    std::string line = fmt::format("==== {} {}\n", when, join(argv, " "));
-    ssize_t w = ::write(fd, line.data(), line.size());
-    (void)w;
-  }
+  const std::vector<std::string> argv{program, "--threads", std::to_string(threads), "sweep", "job", plan.dir, job.key};
   std::vector<char*> cargv;
   for (const auto& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
   cargv.push_back(nullptr);
-  const std::string progress = progress_file(job);
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
@@ -87,7 +63,6 @@ pid_t launch(const Job& job, const std::vector<std::string>& argv) {
     if (::getppid() != parent) ::_exit(143);
     ::dup2(fd, STDOUT_FILENO);
     ::dup2(fd, STDERR_FILENO);
-    ::setenv("BIMART_PROGRESS_FILE", progress.c_str(), 1);
     ::signal(SIGINT, SIG_DFL);
     ::signal(SIGTERM, SIG_DFL);
     ::execv(cargv[0], cargv.data());
@@ -163,10 +138,10 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
       }
       if (!ready) continue;
       const Job& job = plan.jobs[i];
-      const auto argv = command_of(job, program, per_job);
+      const bool resumes = resumes_checkpoint(job);
       Running r;
       r.threads = per_job;
-      r.pid = launch(job, argv);
+      r.pid = launch(plan, job, program, per_job);
       r.started = r.last_report = Clock::now();
       running[i] = r;
       state[i] = State::Running;
@@ -174,7 +149,7 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
       if (!o.quiet)
         std::cout << fmt::format("[{}/{}] start {}: estimate {}{}, log {}\n", started, to_run, job_label(job),
                                  format_duration(estimate_seconds(job, rates, per_job)),
-                                 argv.back() == "--resume" ? " (resumes its checkpoint)" : "", log_file(job))
+                                 resumes ? " (resumes its checkpoint)" : "", log_file(job))
                   << std::flush;
     }
     if (running.empty()) {
@@ -191,15 +166,9 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
         if (it->second.pid != pid) continue;
         const Job& job = plan.jobs[it->first];
         const double secs = std::chrono::duration<double>(Clock::now() - it->second.started).count();
-        const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(job.result);
+        // The runner marks the job done (and records its rate) when its result is there.
+        const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && is_done(job);
         if (ok) {
-          mark_done(job, secs, it->second.threads);
-          // The rate of the last phase seen (a resumed training's steps of this run only).
-          const Running& r = it->second;
-          const double dt = std::chrono::duration<double>(r.last_seen - r.first_seen).count();
-          if (r.total > 0 && r.last_done > r.first_done && dt > 1)
-            record_rate(plan.dir, job.rate_key,
-                        (r.last_done - r.first_done) * job.work / r.total / dt / (1.0 + 0.6 * (r.threads - 1)));
           state[it->first] = State::Done;
           ++sum.ran;
           if (!o.quiet)
@@ -230,11 +199,6 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
         r.label = p.label;
         r.first_done = p.done;
         r.first_seen = now;
-      }
-      if (p.known && p.done != r.last_done) {
-        r.last_done = p.done;
-        r.total = p.total;
-        r.last_seen = now;
       }
       if (o.quiet || std::chrono::duration<double>(now - r.last_report).count() < o.report_every) continue;
       r.last_report = now;

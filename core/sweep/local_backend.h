@@ -1,6 +1,6 @@
-// Runs a sweep's jobs on this machine (docs/sweeps.md): each job is the bimart command of
-// its plan entry, started as a child process with its output in the job's log.txt, up to
-// `jobs` at once with the threads divided between them. Finished jobs (done.json with their
+// Runs a sweep's jobs on this machine (docs/sweeps.md): each job is `bimart sweep job DIR
+// KEY` (core/sweep/job_runner.h), started as a child process with its output in the job's
+// log.txt, up to `jobs` at once with the threads divided between them. Finished jobs (done.json with their
 // key) are skipped; an unfinished training continues from its checkpoint (train --resume)
 // and an unfinished generation keeps the windows it wrote (generate --resume). Children
 // are stopped with SIGTERM (and checkpoint) when the sweep is interrupted or killed.
@@ -22,6 +22,7 @@ struct LocalOptions {
 
 struct RunSummary {
   int already_done = 0, ran = 0, failed = 0, skipped = 0;  // skipped: a dependency failed
+  int pending = 0;  // still queued or running elsewhere when the backend returned (Slurm)
   bool interrupted = false;
   double seconds = 0;
 };

@@ -110,6 +110,10 @@ struct Planner {
     f.add(emit(keyed));
     f.add(init_fp);
     f.add(config["data"] ? dataset_fingerprint(config["data"].as<std::string>()) : std::string());
+    // Each process draws `batch` windows a step: more processes train another model.
+    // (One process adds nothing, so the keys of one-process models stay as they were.)
+    const int world = m.nodes * m.tasks_per_node;
+    if (world > 1) f.add("world " + std::to_string(world));
     Job job;
     job.kind = JobKind::Train;
     job.name = m.name;
@@ -136,7 +140,7 @@ struct Planner {
     }
     job.args = {"train", tc.model, (fs::path(job.folder) / "config.yaml").string()};
     job.result = (fs::path(job.folder) / "model.npz").string();
-    job.work = static_cast<double>(tc.steps) * tc.batch;
+    job.work = static_cast<double>(tc.steps) * tc.batch * world;
     job.unit = "windows";
     job.rate_key = "train " + tc.model + " " + tc.network.describe();
     job.nodes = m.nodes;

@@ -10,6 +10,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstdlib>
+#include <initializer_list>
 #include <thread>
 
 #include "core/data/normalization.h"
@@ -21,6 +23,7 @@
 #include "core/util/error.h"
 #include "tests/data/tiny_dataset.h"
 #include "tests/diffusion/tiny_train_config.h"
+#include "tests/diffusion/union_of_batches.h"
 #include "tests/error_of.h"
 
 namespace bimart::diffusion {
@@ -352,36 +355,94 @@ TEST(Training, TwoProcessesEqualOneOnTheUnionOfTheirBatches) {
   for (const auto& [k, v] : w[0]) EXPECT_TRUE(at::equal(v, w[1].at(k))) << "ranks differ in " << k;
 
   // One process, the union of both ranks' batches, the same steps.
-  WindowDatasetOptions wo;
-  const WindowDataset data = WindowDataset::open(c.data, "train", wo);
-  const NormalizationStats stats = compute_normalization(data);
-  const NoiseSchedule schedule = make_schedule(c.schedule, c.diffusion_steps);
-  torch::manual_seed(c.seed);
-  Denoiser net(c.network);
-  torch::optim::Adam opt(net->parameters(), torch::optim::AdamOptions(c.lr));
-  for (std::int64_t step = 0; step < c.steps; ++step) {
-    const StepInputs a = draw_step(c, stats, data, step, 0), b = draw_step(c, stats, data, step, 1);
-    StepInputs u;
-    u.sample = at::cat({a.sample, b.sample});
-    u.object = at::cat({a.object, b.object});
-    u.contact = at::cat({a.contact, b.contact});
-    u.use_contact = at::cat({a.use_contact, b.use_contact});
-    u.mask = at::cat({a.mask, b.mask});
-    u.noise = at::cat({a.noise, b.noise});
-    u.t = at::cat({a.t, b.t});
-    const LossParts lp = step_loss(net, schedule, u);
-    opt.zero_grad();
-    (lp.sum / lp.frames).backward();
-    for (auto& p : net->parameters())  // as train(): unused parameters get a zero gradient
-      if (!p.grad().defined()) p.mutable_grad() = at::zeros_like(p);
-    for (auto& g : opt.param_groups())
-      static_cast<torch::optim::AdamOptions&>(g.options()).lr(learning_rate(c, step));
-    opt.step();
-  }
-  double worst = 0;
-  for (const auto& p : net->named_parameters())
-    worst = std::max(worst, (p.value() - w[0].at(p.key())).abs().max().item<double>());
+  const TensorMap reference = train_on_union_of_batches(c, 2);
+  const double worst = largest_parameter_difference(reference, w[0]);
   EXPECT_LE(worst, 1e-5);
+}
+
+}  // namespace
+}  // namespace bimart::diffusion
+
+namespace bimart::diffusion {
+namespace {
+
+// Sets (or, with nullptr, unsets) environment variables for one scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(std::initializer_list<std::pair<const char*, const char*>> vars) {
+    for (const auto& [k, v] : vars) {
+      const char* old = std::getenv(k);
+      saved_.push_back({k, old != nullptr, old != nullptr ? old : ""});
+      if (v != nullptr) ::setenv(k, v, 1);
+      else ::unsetenv(k);
+    }
+  }
+  ~ScopedEnv() {
+    for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) {
+      if (it->had) ::setenv(it->name.c_str(), it->value.c_str(), 1);
+      else ::unsetenv(it->name.c_str());
+    }
+  }
+
+ private:
+  struct Saved {
+    std::string name;
+    bool had;
+    std::string value;
+  };
+  std::vector<Saved> saved_;
+};
+
+TEST(Distributed, FirstHostOfASlurmNodeList) {
+  EXPECT_EQ(first_slurm_host("node7"), "node7");
+  EXPECT_EQ(first_slurm_host("gpu[03-05,9],cpu1"), "gpu03");
+  EXPECT_EQ(first_slurm_host("cn[7,2-4]"), "cn7");
+  EXPECT_EQ(first_slurm_host("a-[1-2]-x,b"), "a-1-x");
+  EXPECT_EQ(first_slurm_host("r[2-3]n[01-04]"), "r2n01");
+  EXPECT_THROW(first_slurm_host(""), Error);
+  EXPECT_THROW(first_slurm_host("n[]"), Error);
+}
+
+TEST(Distributed, SlurmVariablesStandInForUnsetTorchOnesInsideASrunStep) {
+  {
+    ScopedEnv env{{"WORLD_SIZE", nullptr},           {"RANK", nullptr},          {"MASTER_ADDR", nullptr},
+                  {"MASTER_PORT", nullptr},          {"SLURM_STEP_NUM_TASKS", "4"}, {"SLURM_PROCID", "2"},
+                  {"SLURM_STEP_NODELIST", "n[12-13]"}, {"SLURM_JOB_ID", "12345"}};
+    const auto o = DataParallel::options_from_environment();
+    ASSERT_TRUE(o.has_value());
+    EXPECT_EQ(o->world_size, 4);
+    EXPECT_EQ(o->rank, 2);
+    EXPECT_EQ(o->master_addr, "n12");
+    EXPECT_EQ(o->master_port, 15000 + 12345 % 20000);
+    {
+      ScopedEnv torch_wins{{"MASTER_PORT", "29999"}, {"MASTER_ADDR", "10.0.0.1"}};
+      const auto t = DataParallel::options_from_environment();
+      ASSERT_TRUE(t.has_value());
+      EXPECT_EQ(t->master_port, 29999);
+      EXPECT_EQ(t->master_addr, "10.0.0.1");
+    }
+    {
+      ScopedEnv bad{{"SLURM_PROCID", "x"}};
+      const std::string e = test::error_of([] { DataParallel::options_from_environment(); });
+      EXPECT_NE(e.find("SLURM_PROCID"), std::string::npos) << e;
+    }
+  }
+  {
+    // A batch script outside any srun step, or a step of one task: one process.
+    ScopedEnv env{{"WORLD_SIZE", nullptr}, {"SLURM_STEP_NUM_TASKS", nullptr}, {"SLURM_NTASKS", "4"},
+                  {"SLURM_PROCID", "0"}};
+    EXPECT_FALSE(DataParallel::options_from_environment().has_value());
+    ScopedEnv one{{"SLURM_STEP_NUM_TASKS", "1"}};
+    EXPECT_FALSE(DataParallel::options_from_environment().has_value());
+  }
+  {
+    ScopedEnv env{{"WORLD_SIZE", "2"}, {"RANK", "1"}, {"MASTER_ADDR", "h"}, {"MASTER_PORT", "1234"},
+                  {"SLURM_STEP_NUM_TASKS", nullptr}};
+    const auto o = DataParallel::options_from_environment();
+    ASSERT_TRUE(o.has_value());
+    EXPECT_EQ(o->rank, 1);
+    EXPECT_EQ(o->master_addr, "h");
+  }
 }
 
 }  // namespace

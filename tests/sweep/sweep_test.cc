@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -17,27 +18,12 @@
 #include <nlohmann/json.hpp>
 
 #include "core/sweep/sweep_file.h"
-#include "tests/cli/run_bimart.h"
-#include "tests/data/tiny_dataset.h"
+#include "tests/sweep/tiny_sweep.h"
 
 namespace bimart {
 namespace {
 
 namespace fs = std::filesystem;
-
-int exit_code(const test::CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
-
-std::string read(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p) << text;
-}
 
 const fs::path& scratch() {
   static const fs::path d = [] {
@@ -49,75 +35,16 @@ const fs::path& scratch() {
   return d;
 }
 
-std::string tiny_config(const std::string& model, int steps) {
-  return "model: " + model + "\ndata: " + testing_data::tiny_dataset().dir.string() +
-         "\nout: unused\nvariant: np_bps\nstride: 16\n"
-         "network: {latent: 16, layers: 1, heads: 2, feedforward: 32, condition_hidden: 32, dropout: 0.1}\n"
-         "diffusion: {schedule: squaredcos_cap_v2, steps: 10}\n"
-         "training: {batch: 4, steps: " +
-         std::to_string(steps) +
-         ", lr: 1.0e-3, warmup: 2, noisy_from: 5, seed: 1, checkpoint_every: 2, validate_every: 0, log_every: 5}\n";
-}
-
-// contact maps, motion, MANO fit, one export: the rows' runs.
-const char* kPipeline = R"(name: tiny_eval
-stages:
-  - id: sequence
-    use: trajectory.sequence
-    params: {path: unused.npz}
-  - id: encoder
-    use: encoder.np_bps
-  - id: contact
-    use: contact.diffusion
-  - id: motion
-    use: motion.diffusion
-  - id: fit
-    use: refine.mano_fit
-  - id: guided
-    use: export.sequence
-    params: {path: unused.npz}
-)";
-
-std::string sweep_text(const std::string& without_c_extra = "") {
-  const fs::path s = scratch();
-  return "name: tiny\n"
-         "base:\n"
-         "  data: " + testing_data::tiny_dataset().dir.string() + "\n"
-         "  split: test\n  samples: 2\n  seed: 0\n  window: 32\n"
-         "  pipeline: " + (s / "tiny_eval.yaml").string() + "\n"
-         "  output: guided\n"
-         "models:\n"
-         "  contact: {train: " + (s / "contact.yaml").string() + "}\n"
-         "  motion: {train: " + (s / "motion.yaml").string() + "}\n"
-         "rows:\n"
-         "  - name: w C\n"
-         "    section: Contact\n"
-         "    models: {contact: contact, motion: motion}\n"
-         "    paper: {Mul: 6.97928, Accel: 0.31398, Pen 1cm: 20.273, Con: 98.481, Art: 83.089, CM: 1.1505}\n"
-         "  - name: w/o C\n"
-         "    section: Contact\n"
-         "    models: {contact: contact, motion: motion}\n"
-         "    set: {motion.use_contact: false" + without_c_extra + "}\n"
-         "    paper: {Mul: 4.4894, Accel: 0.31034, Pen 1cm: 9.4481, Con: 96.129, Art: 79.591}\n"
-         "  - name: NP-BPS\n"
-         "    section: Rep\n"
-         "    models: {contact: contact, motion: motion}\n";
-}
-
-// The table without its wall-time column.
-std::string table_numbers(const fs::path& dir) {
-  std::string out;
-  std::istringstream in(read(dir / "table.csv"));
-  for (std::string line; std::getline(in, line);) out += line.substr(0, line.rfind(',')) + "\n";
-  return out;
-}
+using test::exit_code;
+using test::table_numbers;
+std::string read(const fs::path& p) { return test::read_text(p); }
+void write(const fs::path& p, const std::string& text) { test::write_text(p, text); }
+std::string sweep_text(const std::string& without_c_extra = "") { return test::tiny_sweep_text(scratch(), without_c_extra); }
 
 class Sweep : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    write(scratch() / "contact.yaml", tiny_config("contact", 24));
-    write(scratch() / "motion.yaml", tiny_config("motion", 24));
-    write(scratch() / "tiny_eval.yaml", kPipeline);
+    test::write_tiny_sweep_inputs(scratch(), 24);
     write(scratch() / "sweep.yaml", sweep_text());
     first_ = new test::CliRun(test::run_bimart("--threads 2 sweep " + (scratch() / "sweep.yaml").string() + " --out " +
                                                (scratch() / "a").string() + " --jobs 2 --report-every 1"));
@@ -240,6 +167,54 @@ TEST_F(Sweep, RowsFlagRunsOnlyTheNamedRows) {
   const auto bad = test::run_bimart("sweep " + (scratch() / "sweep.yaml").string() + " --rows 'w/o G' --dry-run");
   EXPECT_EQ(exit_code(bad), 1);
   EXPECT_NE(bad.output.find("did you mean 'w/o C'"), std::string::npos) << bad.output;
+}
+
+TEST_F(Sweep, ATrainingOfTwoTasksRunsAsTwoRanksOnThisMachine) {
+  ASSERT_EQ(exit_code(*first_), 0) << first_->output;
+  const fs::path d = scratch() / "d";
+  fs::copy(scratch() / "a", d, fs::copy_options::recursive);
+  write(scratch() / "sweep_d.yaml",
+        test::tiny_sweep_text(scratch(), "", "  dp: {train: " + (scratch() / "motion.yaml").string() + ", tasks_per_node: 2}\n",
+                              "  - name: two tasks\n    models: {contact: contact, motion: dp}\n"));
+  const auto r = test::run_bimart("--threads 2 sweep " + (scratch() / "sweep_d.yaml").string() + " --out " + d.string() +
+                                  " --rows 'two tasks'");
+  ASSERT_EQ(exit_code(r), 0) << r.output;
+  // The contact model is shared; the two-process motion model is another model (its key).
+  EXPECT_NE(r.output.find("3 jobs ran, 1 were done before"), std::string::npos) << r.output;
+  const auto plan = nlohmann::json::parse(read(d / "plan.json"));
+  std::string dp_folder;
+  for (const auto& job : plan["jobs"])
+    if (job["name"] == "dp") dp_folder = job["folder"].get<std::string>();
+  ASSERT_FALSE(dp_folder.empty());
+  EXPECT_FALSE(fs::exists(scratch() / "a" / "models" / fs::path(dp_folder).filename()));
+  const std::string log = read(fs::path(dp_folder) / "log.txt");
+  EXPECT_NE(log.find("(2 processes, MASTER_PORT="), std::string::npos) << log;
+  EXPECT_TRUE(fs::exists(fs::path(dp_folder) / "model.npz"));
+  const auto done = nlohmann::json::parse(read(fs::path(dp_folder) / "done.json"));
+  EXPECT_EQ(done["threads"], 2);  // two processes of one thread each
+  EXPECT_EQ(done["work"].get<double>(), 24.0 * 4 * 2);  // steps x batch x processes
+
+  // One job by hand: a done one is left alone, an unknown key is an error.
+  const auto again = test::run_bimart("sweep job " + d.string() + " " + fs::path(dp_folder).filename().string());
+  EXPECT_EQ(exit_code(again), 0) << again.output;
+  EXPECT_NE(again.output.find("is done already"), std::string::npos) << again.output;
+  const auto unknown = test::run_bimart("sweep job " + d.string() + " 0123456789abcdef");
+  EXPECT_EQ(exit_code(unknown), 1) << unknown.output;
+  EXPECT_NE(unknown.output.find("has no job with the key '0123456789abcdef'"), std::string::npos) << unknown.output;
+}
+
+TEST(SweepBackends, UnknownBackendAndSlurmWithoutSbatchAreClearErrors) {
+  const auto unknown = test::run_bimart("sweep " + std::string(BIMART_SOURCE_DIR) +
+                                        "/pipelines/sweeps/table3.yaml --backend slurmm --dry-run");
+  EXPECT_EQ(exit_code(unknown), 1) << unknown.output;
+  EXPECT_NE(unknown.output.find("unknown backend (known: local, slurm)"), std::string::npos) << unknown.output;
+  // A PATH without sbatch (the machine may have Slurm installed).
+  const std::string old_path = std::getenv("PATH") != nullptr ? std::getenv("PATH") : "";
+  ::setenv("PATH", "/nonexistent", 1);
+  const auto r = test::run_bimart("sweep " + std::string(BIMART_SOURCE_DIR) + "/pipelines/sweeps/table3.yaml --backend slurm");
+  ::setenv("PATH", old_path.c_str(), 1);
+  EXPECT_EQ(exit_code(r), 1) << r.output;
+  EXPECT_NE(r.output.find("--backend slurm: sbatch is not on PATH"), std::string::npos) << r.output;
 }
 
 // ---- sweep-file mistakes: file, line, nearest key ----
