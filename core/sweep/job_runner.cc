@@ -22,6 +22,7 @@
 #include "core/sweep/job_state.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
+#include "core/util/interrupt.h"
 #include "core/util/subprocess.h"
 #include "core/util/text.h"
 
@@ -30,9 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_job_signal(int) { g_stop = 1; }
 
 // A free TCP port on loopback for rank 0's store (the kernel's choice; another program
 // could take it before rank 0 binds it, which the ranks then report as a join error).
@@ -209,12 +207,7 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
   }
   std::cout << fmt::format("==== {} {}{}\n", now_text(), join(argvs.front(), " "), how) << std::flush;
 
-  struct sigaction sa{}, old_int{}, old_term{};
-  sa.sa_handler = on_job_signal;
-  sigemptyset(&sa.sa_mask);
-  g_stop = 0;
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
+  const StopSignalScope signals;  // Ctrl-C, SIGTERM: stop the children first
 
   const auto t0 = Clock::now();
   std::map<pid_t, int> alive;  // pid -> rank
@@ -224,7 +217,7 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
   RateWatch watch;
   auto last_look = Clock::now();
   while (!alive.empty()) {
-    if (g_stop && !forwarded) {
+    if (signals.stop_requested() && !forwarded) {
       forwarded = true;
       for (const auto& [pid, r] : alive) ::kill(pid, SIGTERM);
     }
@@ -247,11 +240,9 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
       watch.look(job);
       last_look = Clock::now();
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ::usleep(100 * 1000);  // a signal ends it at once (EINTR), so SIGTERM reaches the children without delay
   }
   watch.look(job);
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
   if (!failed && fs::exists(job.result)) {
@@ -260,7 +251,7 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
     std::cout << fmt::format("==== {} done: {} in {}\n", now_text(), label, format_duration(seconds)) << std::flush;
     return 0;
   }
-  if (g_stop || forwarded) {
+  if (signals.stop_requested() || forwarded) {
     std::cout << fmt::format("==== {} stopped: {} (a rerun continues it)\n", now_text(), label) << std::flush;
     return 130;
   }

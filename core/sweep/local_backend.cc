@@ -17,6 +17,7 @@
 #include "core/sweep/job_runner.h"
 #include "core/sweep/job_state.h"
 #include "core/util/error.h"
+#include "core/util/interrupt.h"
 #include "core/util/text.h"
 
 namespace bimart::sweep {
@@ -24,9 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_sweep_signal(int) { g_stop = 1; }
 
 enum class State { Pending, Running, Done, Failed, Skipped };
 
@@ -102,19 +100,13 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
                              plan.jobs.size(), sum.already_done, to_run, jobs, per_job, per_job == 1 ? "" : "s")
               << std::flush;
 
-  struct sigaction sa, old_int, old_term;
-  std::memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_sweep_signal;
-  sigemptyset(&sa.sa_mask);
-  g_stop = 0;
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
+  const StopSignalScope signals;  // Ctrl-C, SIGTERM: stop the children first
 
   std::map<std::size_t, Running> running;
   int started = 0;
   bool stopping = false;
   while (true) {
-    if (g_stop && !stopping) {
+    if (signals.stop_requested() && !stopping) {
       stopping = true;
       sum.interrupted = true;
       if (!running.empty())
@@ -213,10 +205,8 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
       }
       std::cout << line << "\n" << std::flush;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    ::usleep(200 * 1000);  // a signal ends it at once (EINTR), so SIGTERM reaches the children without delay
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
   sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return sum;
 }

@@ -17,6 +17,7 @@
 #include "core/sweep/job_state.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
+#include "core/util/interrupt.h"
 #include "core/util/subprocess.h"
 #include "core/util/text.h"
 
@@ -26,9 +27,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_slurm_wait_signal(int) { g_stop = 1; }
 
 std::string slurm_file(const Job& job) { return (fs::path(job.folder) / "slurm.json").string(); }
 std::string job_label(const Job& job) { return fmt::format("{} {}", job_kind_name(job.kind), job.name); }
@@ -207,18 +205,13 @@ RunSummary run_slurm(const Plan& plan, const SlurmOptions& o) {
     return sum;
   }
 
-  struct sigaction sa{}, old_int{}, old_term{};
-  sa.sa_handler = on_slurm_wait_signal;
-  sigemptyset(&sa.sa_mask);
-  g_stop = 0;
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
+  const StopSignalScope signals;  // Ctrl-C, SIGTERM: stop waiting; the jobs stay queued
   std::map<std::size_t, std::string> last_state;
   std::map<std::size_t, Clock::time_point> last_report;
   std::set<std::size_t> ended;
   std::set<std::size_t> failed_jobs;
   auto last_poll = Clock::now() - std::chrono::hours(1);
-  while (ended.size() < watched.size() && !g_stop) {
+  while (ended.size() < watched.size() && !signals.stop_requested()) {
     if (std::chrono::duration<double>(Clock::now() - last_poll).count() < o.poll_seconds) {
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       continue;
@@ -272,9 +265,7 @@ RunSummary run_slurm(const Plan& plan, const SlurmOptions& o) {
       }
     }
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
-  if (g_stop) {
+  if (signals.stop_requested()) {
     sum.interrupted = true;
     sum.pending = static_cast<int>(watched.size() - ended.size());
     std::cout << fmt::format("stopped waiting: {} job{} stay in Slurm's queue (bimart sweep status {}; scancel stops them)\n",

@@ -54,4 +54,26 @@ InterruptCleanup::~InterruptCleanup() {
   claimed[slot_] = false;
 }
 
+namespace {
+volatile std::sig_atomic_t stop_flag = 0;
+// A name of its own: extern "C" names are global across the program and its libraries.
+extern "C" void bimart_stop_signal_scope_handler(int) { stop_flag = 1; }
+}  // namespace
+
+StopSignalScope::StopSignalScope() {
+  struct sigaction sa{};
+  sa.sa_handler = bimart_stop_signal_scope_handler;
+  sigemptyset(&sa.sa_mask);
+  stop_flag = 0;
+  sigaction(SIGINT, &sa, &old_int_);
+  sigaction(SIGTERM, &sa, &old_term_);
+}
+
+StopSignalScope::~StopSignalScope() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+}
+
+bool StopSignalScope::stop_requested() const { return stop_flag != 0; }
+
 }  // namespace bimart

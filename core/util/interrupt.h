@@ -3,6 +3,8 @@
 // (core/util/atomic_file.h) are removed first. Targets of writes are never touched.
 #pragma once
 
+#include <signal.h>
+
 #include <string>
 
 namespace bimart {
@@ -20,6 +22,22 @@ class InterruptCleanup {
 
  private:
   int slot_;
+};
+
+// While alive, SIGINT and SIGTERM only set a flag instead of ending the program, so a
+// loop that runs children can stop them first (bimart sweep's backends and job runner);
+// the previous handlers come back at the end of the scope. One scope at a time.
+class StopSignalScope {
+ public:
+  StopSignalScope();
+  ~StopSignalScope();
+  StopSignalScope(const StopSignalScope&) = delete;
+  StopSignalScope& operator=(const StopSignalScope&) = delete;
+  // True once SIGINT or SIGTERM arrived in this scope.
+  bool stop_requested() const;
+
+ private:
+  struct sigaction old_int_{}, old_term_{};
 };
 
 }  // namespace bimart
