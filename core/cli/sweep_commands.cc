@@ -102,12 +102,11 @@ std::string slurm_text(const Job& job, const std::map<long, SlurmJobState>& queu
   if (id <= 0) return "";
   const auto it = queue.find(id);
   if (it == queue.end()) return fmt::format(", Slurm job {} (no longer in squeue)", id);
-  const SlurmJobState& q = it->second;
-  std::string s = fmt::format(", Slurm job {} {}", id, q.state);
-  if (q.state == "PENDING" && !q.reason.empty() && q.reason != "None") s += " (" + q.reason + ")";
-  if (q.state == "RUNNING" && !q.nodes.empty()) s += " on " + q.nodes;
-  return s;
+  return fmt::format(", Slurm job {} {}", id, slurm_state_text(it->second));
 }
+
+// --bimart as an absolute path ("" = this program).
+std::string program_option(const SweepArgs& a) { return a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string(); }
 
 std::vector<std::string> split_spaces(const std::string& s) {
   std::vector<std::string> out;
@@ -166,7 +165,7 @@ int run_sweep(const SweepArgs& a) {
     so.account = a.account;
     so.time_limit = a.time_limit;
     so.sbatch_args = split_spaces(a.sbatch_args);
-    so.program = a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string();
+    so.program = program_option(a);
     so.cpus_per_task = a.cpus_per_task;
     so.wait = !a.detach;
     so.report_every = a.report_every;
@@ -176,7 +175,7 @@ int run_sweep(const SweepArgs& a) {
     LocalOptions lo;
     lo.jobs = a.jobs;
     lo.threads = threads;
-    lo.program = a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string();
+    lo.program = program_option(a);
     lo.report_every = a.report_every;
     lo.quiet = common_options().quiet > 0;
     s = run_local(plan, lo);
@@ -277,7 +276,7 @@ void add_sweep_commands(CLI::App& app, Commands& out) {
                    if (status->parsed()) return run_status(a.status_dir);
                    if (job->parsed()) {
                      JobRunOptions jo;
-                     jo.program = a.bimart.empty() ? std::string() : fs::absolute(a.bimart).string();
+                     jo.program = program_option(a);
                      const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
                      jo.threads = common_options().threads > 0 ? common_options().threads : cores;
                      return run_job(read_plan_json(a.job_dir), a.job_key, jo);

@@ -126,20 +126,20 @@ std::optional<DataParallelOptions> DataParallel::options_from_environment() {
   o.world_size = torch_or_slurm("WORLD_SIZE", "SLURM_STEP_NUM_TASKS", in_slurm, 1, 65536);
   if (o.world_size == 1) return std::nullopt;
   o.rank = torch_or_slurm("RANK", "SLURM_PROCID", in_slurm, 0, o.world_size - 1);
-  if (const char* addr = env("MASTER_ADDR")) {
+  const char* nodes = env("SLURM_STEP_NODELIST") ? env("SLURM_STEP_NODELIST") : env("SLURM_JOB_NODELIST");
+  if (const char* addr = env("MASTER_ADDR"))
     o.master_addr = addr;
-  } else if (in_slurm && (env("SLURM_STEP_NODELIST") || env("SLURM_JOB_NODELIST"))) {
-    o.master_addr = first_slurm_host(env("SLURM_STEP_NODELIST") ? env("SLURM_STEP_NODELIST") : env("SLURM_JOB_NODELIST"));
-  } else {
-    throw Error(std::string("distributed training: MASTER_ADDR is not set") +
-                (in_slurm ? " (nor SLURM_STEP_NODELIST)" : ""));
-  }
-  if (env("MASTER_PORT") == nullptr && in_slurm && env("SLURM_JOB_ID") != nullptr) {
-    // One port per job, so two jobs' ranks on a node do not meet.
-    o.master_port = 15000 + parse_int("SLURM_JOB_ID", env("SLURM_JOB_ID"), 0, 2147483647) % 20000;
-  } else {
-    o.master_port = torch_or_slurm("MASTER_PORT", "SLURM_JOB_ID", false, 1, 65535);
-  }
+  else if (in_slurm && nodes != nullptr)
+    o.master_addr = first_slurm_host(nodes);
+  else
+    throw Error(std::string("distributed training: MASTER_ADDR is not set") + (in_slurm ? " (nor SLURM_STEP_NODELIST)" : ""));
+  const char* job = env("SLURM_JOB_ID");
+  if (const char* port = env("MASTER_PORT"))
+    o.master_port = parse_int("MASTER_PORT", port, 1, 65535);
+  else if (in_slurm && job != nullptr)  // one port per job, so two jobs' ranks on a node do not meet
+    o.master_port = 15000 + parse_int("SLURM_JOB_ID", job, 0, 2147483647) % 20000;
+  else
+    throw Error(std::string("distributed training: MASTER_PORT is not set") + (in_slurm ? " (nor SLURM_JOB_ID)" : ""));
   return o;
 }
 

@@ -2,7 +2,6 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,7 +14,6 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <thread>
 
 #include <fmt/format.h>
 
@@ -51,71 +49,12 @@ int free_loopback_port() {
   return ntohs(a.sin_port);
 }
 
-// Starts argv with `env` added; the child gets SIGTERM (and checkpoints) if this process dies.
-pid_t spawn(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env) {
-  std::vector<char*> cargv;
-  for (const auto& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
-  cargv.push_back(nullptr);
-  const pid_t parent = ::getpid();
-  std::cout << std::flush;
-  const pid_t pid = ::fork();
-  if (pid < 0) throw Error(std::string("cannot start the job: fork failed: ") + std::strerror(errno));
-  if (pid == 0) {
-    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (::getppid() != parent) ::_exit(143);
-    for (const auto& [k, v] : env) ::setenv(k.c_str(), v.c_str(), 1);
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    ::execvp(cargv[0], cargv.data());
-    const std::string msg = "bimart sweep job: cannot execute " + argv[0] + ": " + std::strerror(errno) + "\n";
-    ssize_t w = ::write(STDERR_FILENO, msg.data(), msg.size());
-    (void)w;
-    ::_exit(127);
-  }
-  return pid;
-}
-
 std::string now_text() {
   const std::time_t now = std::time(nullptr);
   char when[32];
   std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S", std::localtime(&now));
   return when;
 }
-
-std::string exit_text(int status) {
-  if (WIFEXITED(status)) return fmt::format("exit code {}", WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) return fmt::format("signal {}", WTERMSIG(status));
-  return "unknown status";
-}
-
-// The progress of the last phase seen (a resumed training's steps of this run only), for
-// the rate recorded when the job finishes.
-struct RateWatch {
-  std::string label;
-  double first_done = -1, last_done = -1, total = 0;
-  Clock::time_point first_seen, last_seen;
-  void look(const Job& job) {
-    const Progress p = read_progress(job);
-    const auto now = Clock::now();
-    if (!p.known) return;
-    if (first_done < 0 || p.label != label) {
-      label = p.label;
-      first_done = p.done;
-      first_seen = now;
-    }
-    if (p.done != last_done) {
-      last_done = p.done;
-      total = p.total;
-      last_seen = now;
-    }
-  }
-  // Work units per second of one thread of one process; 0 when too little was seen.
-  double per_thread(const Job& job, int threads, int processes) const {
-    const double dt = std::chrono::duration<double>(last_seen - first_seen).count();
-    if (!(total > 0) || last_done <= first_done || dt <= 1) return 0;
-    return (last_done - first_done) * job.work / total / dt / (1.0 + 0.6 * (threads - 1)) / processes;
-  }
-};
 
 }  // namespace
 
@@ -147,7 +86,7 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
     if (plan.jobs[i].key == key) index = i;
   if (index == plan.jobs.size()) throw Error("sweep " + plan.dir + " has no job with the key '" + key + "'");
   const Job& job = plan.jobs[index];
-  const std::string label = fmt::format("{} {}", job_kind_name(job.kind), job.name);
+  const std::string label = job_label(job);
   if (is_done(job)) {
     std::cout << label << " (" << key << ") is done already\n";
     return 0;
@@ -211,10 +150,10 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
 
   const auto t0 = Clock::now();
   std::map<pid_t, int> alive;  // pid -> rank
-  for (std::size_t r = 0; r < argvs.size(); ++r) alive[spawn(argvs[r], envs[r])] = static_cast<int>(r);
+  for (std::size_t r = 0; r < argvs.size(); ++r) alive[start_child(argvs[r], envs[r])] = static_cast<int>(r);
   bool forwarded = false, failed = false;
   std::string why;
-  RateWatch watch;
+  ProgressWatch watch;  // for the rate recorded at the end
   auto last_look = Clock::now();
   while (!alive.empty()) {
     if (signals.stop_requested() && !forwarded) {
@@ -228,7 +167,8 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
       alive.erase(pid);
       if (!(WIFEXITED(status) && WEXITSTATUS(status) == 0) && !failed) {
         failed = true;
-        why = processes > 1 ? fmt::format("process {} ended with {}", rank, exit_text(status)) : exit_text(status);
+        why = exit_status_text(status);
+        if (processes > 1) why = fmt::format("process {} ended with {}", rank, why);
         // One rank gone: the others would wait for it until their timeout.
         if (!forwarded)
           for (const auto& [p, r] : alive) ::kill(p, SIGTERM);
@@ -247,11 +187,11 @@ int run_job(const Plan& plan, const std::string& key, const JobRunOptions& o) {
 
   if (!failed && fs::exists(job.result)) {
     mark_done(job, seconds, threads * processes);
-    record_rate(plan.dir, job.rate_key, watch.per_thread(job, threads, processes));
+    record_rate(plan.dir, job.rate_key, watch.work_per_thread(job, threads, processes));
     std::cout << fmt::format("==== {} done: {} in {}\n", now_text(), label, format_duration(seconds)) << std::flush;
     return 0;
   }
-  if (signals.stop_requested() || forwarded) {
+  if (signals.stop_requested()) {
     std::cout << fmt::format("==== {} stopped: {} (a rerun continues it)\n", now_text(), label) << std::flush;
     return 130;
   }

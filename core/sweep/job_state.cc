@@ -17,12 +17,16 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-json read_json(const fs::path& p) {
+}  // namespace
+
+json read_json_or_empty(const std::string& p) {
   std::ifstream in(p);
   if (!in) return json::object();
   json j = json::parse(in, nullptr, false);
   return j.is_discarded() ? json::object() : j;
 }
+
+namespace {
 
 // Work units per second with one thread, measured on the 2-core AMD EPYC of
 // docs/performance.md with the shipped sizes; used until a sweep has measured its own.
@@ -38,13 +42,11 @@ double default_rate(const Job& job) {
 
 }  // namespace
 
-json read_json_or_empty(const std::string& path) { return read_json(path); }
-
 std::string done_file(const Job& job) { return (fs::path(job.folder) / "done.json").string(); }
 std::string log_file(const Job& job) { return (fs::path(job.folder) / "log.txt").string(); }
 std::string progress_file(const Job& job) { return (fs::path(job.folder) / "progress.json").string(); }
 
-json read_done(const Job& job) { return read_json(done_file(job)); }
+json read_done(const Job& job) { return read_json_or_empty(done_file(job)); }
 
 bool is_done(const Job& job) {
   const json d = read_done(job);
@@ -68,10 +70,15 @@ std::vector<bool> needed_jobs(const Plan& plan) {
   return needed;
 }
 
-void mark_done(const Job& job, double seconds, int threads) {
+std::string utc_now_text() {
   const std::time_t now = std::time(nullptr);
   char when[32];
   std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return when;
+}
+
+void mark_done(const Job& job, double seconds, int threads) {
+  const std::string when = utc_now_text();
   const json d{{"key", job.key},     {"kind", job_kind_name(job.kind)},
                {"name", job.name},   {"seconds", seconds},
                {"threads", threads}, {"work", job.work},
@@ -80,8 +87,41 @@ void mark_done(const Job& job, double seconds, int threads) {
   write_file_atomically(done_file(job), [&](std::ostream& o) { o << d.dump(2) << "\n"; });
 }
 
+double thread_speedup(int threads) {
+  // Two threads do not make one job twice as fast (docs/performance.md): count the second
+  // and later threads at 60 %.
+  return 1.0 + 0.6 * std::max(0, threads - 1);
+}
+
+Progress ProgressWatch::look(const Job& job) {
+  const Progress p = read_progress(job);
+  if (!p.known) return p;
+  const auto now = std::chrono::steady_clock::now();
+  if (first_done_ < 0 || p.label != label_) {
+    label_ = p.label;
+    first_done_ = last_done_ = p.done;
+    first_seen_ = last_seen_ = now;
+  }
+  if (p.done != last_done_) {
+    last_done_ = p.done;
+    last_seen_ = now;
+  }
+  total_ = p.total;
+  return p;
+}
+
+double ProgressWatch::rate() const {
+  const double dt = std::chrono::duration<double>(last_seen_ - first_seen_).count();
+  return first_done_ >= 0 && last_done_ > first_done_ && dt > 1 ? (last_done_ - first_done_) / dt : 0;
+}
+
+double ProgressWatch::work_per_thread(const Job& job, int threads, int processes) const {
+  if (!(total_ > 0)) return 0;
+  return rate() * job.work / total_ / thread_speedup(threads) / std::max(1, processes);
+}
+
 Progress read_progress(const Job& job) {
-  const json j = read_json(progress_file(job));
+  const json j = read_json_or_empty(progress_file(job));
   Progress p;
   if (!j.contains("done") || !j.contains("total")) return p;
   p.label = j.value("label", std::string());
@@ -107,7 +147,7 @@ std::string log_tail(const Job& job, int lines) {
 
 std::map<std::string, double> read_rates(const std::string& dir) {
   std::map<std::string, double> r;
-  const json j = read_json(fs::path(dir) / "rates.json");
+  const json j = read_json_or_empty((fs::path(dir) / "rates.json").string());
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.value().is_number()) r[it.key()] = it.value().get<double>();
   return r;
@@ -115,7 +155,7 @@ std::map<std::string, double> read_rates(const std::string& dir) {
 
 void record_rate(const std::string& dir, const std::string& rate_key, double per_thread) {
   if (!(per_thread > 0) || !std::isfinite(per_thread)) return;
-  json j = read_json(fs::path(dir) / "rates.json");
+  json j = read_json_or_empty((fs::path(dir) / "rates.json").string());
   j[rate_key] = per_thread;
   write_file_atomically((fs::path(dir) / "rates.json").string(), [&](std::ostream& o) { o << j.dump(2) << "\n"; });
 }
@@ -123,9 +163,7 @@ void record_rate(const std::string& dir, const std::string& rate_key, double per
 double estimate_seconds(const Job& job, const std::map<std::string, double>& rates, int threads) {
   const auto it = rates.find(job.rate_key);
   const double per_thread = it != rates.end() ? it->second : default_rate(job);
-  // Two threads do not make one job twice as fast (docs/performance.md): count the second
-  // and later threads at 60 %.
-  const double speed = per_thread * (1.0 + 0.6 * std::max(0, threads - 1));
+  const double speed = per_thread * thread_speedup(threads);
   return job.work / std::max(speed, 1e-9);
 }
 
@@ -163,7 +201,7 @@ void write_plan_json(const Plan& plan) {
 Plan read_plan_json(const std::string& dir) {
   const fs::path p = fs::path(dir) / "plan.json";
   if (!fs::exists(p)) throw Error(dir + " holds no sweep (no plan.json): run bimart sweep SWEEP.yaml --out " + dir);
-  const json j = read_json(p);
+  const json j = read_json_or_empty(p.string());
   if (!j.contains("jobs")) throw Error(p.string() + " is not a sweep plan");
   Plan plan;
   plan.dir = dir;

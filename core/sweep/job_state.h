@@ -4,6 +4,7 @@
 // output. A folder whose done.json holds another key is not done.
 #pragma once
 
+#include <chrono>
 #include <map>
 #include <string>
 
@@ -37,6 +38,28 @@ struct Progress {
   bool known = false;
 };
 Progress read_progress(const Job& job);
+
+// Follows a running job's progress: the current phase (its label) from its first reading
+// to its last, and when each was seen (a resumed training: this run's steps only).
+class ProgressWatch {
+ public:
+  Progress look(const Job& job);  // reads progress.json now; a new label starts a new phase
+  // The phase's units per second from its first reading to its last; 0 until it has
+  // advanced over more than a second.
+  double rate() const;
+  // The job's work units per second of one thread of one process (for record_rate).
+  double work_per_thread(const Job& job, int threads, int processes) const;
+
+ private:
+  std::string label_;
+  double first_done_ = -1, last_done_ = -1, total_ = 0;
+  std::chrono::steady_clock::time_point first_seen_, last_seen_;
+};
+
+// How much faster one job runs with `threads` threads than with one.
+double thread_speedup(int threads);
+// "2026-12-05T09:20:34Z".
+std::string utc_now_text();
 
 // The last `lines` lines of the job's log ("" when there is none).
 std::string log_tail(const Job& job, int lines);

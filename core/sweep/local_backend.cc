@@ -18,6 +18,7 @@
 #include "core/sweep/job_state.h"
 #include "core/util/error.h"
 #include "core/util/interrupt.h"
+#include "core/util/subprocess.h"
 #include "core/util/text.h"
 
 namespace bimart::sweep {
@@ -30,12 +31,8 @@ enum class State { Pending, Running, Done, Failed, Skipped };
 
 struct Running {
   pid_t pid = -1;
-  int threads = 1;
   Clock::time_point started, last_report;
-  // Progress of the current phase (its label): the first reading, and when.
-  std::string label;
-  double first_done = -1;
-  Clock::time_point first_seen;
+  ProgressWatch progress;
 };
 
 // `program --threads T sweep job DIR KEY` (core/sweep/job_runner.h) with its output in the
@@ -46,34 +43,15 @@ pid_t launch(const Plan& plan, const Job& job, const std::string& program, int t
   const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (fd < 0) throw Error("cannot write " + log + ": " + std::strerror(errno));
   const std::vector<std::string> argv{program, "--threads", std::to_string(threads), "sweep", "job", plan.dir, job.key};
-  std::vector<char*> cargv;
-  for (const auto& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
-  cargv.push_back(nullptr);
-  const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
-  if (pid < 0) {
+  try {
+    const pid_t pid = start_child(argv, {}, fd);
     ::close(fd);
-    throw Error(std::string("cannot start a job: fork failed: ") + std::strerror(errno));
+    return pid;
+  } catch (...) {
+    ::close(fd);
+    throw;
   }
-  if (pid == 0) {
-    // The child: stopped (and so checkpointed) with SIGTERM when the sweep dies, even by SIGKILL.
-    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (::getppid() != parent) ::_exit(143);
-    ::dup2(fd, STDOUT_FILENO);
-    ::dup2(fd, STDERR_FILENO);
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGTERM, SIG_DFL);
-    ::execv(cargv[0], cargv.data());
-    const char msg[] = "bimart sweep: cannot execute the job's program\n";
-    ssize_t w = ::write(STDERR_FILENO, msg, sizeof msg - 1);
-    (void)w;
-    ::_exit(127);
-  }
-  ::close(fd);
-  return pid;
 }
-
-std::string job_label(const Job& job) { return fmt::format("{} {}", job_kind_name(job.kind), job.name); }
 
 }  // namespace
 
@@ -132,7 +110,6 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
       const Job& job = plan.jobs[i];
       const bool resumes = resumes_checkpoint(job);
       Running r;
-      r.threads = per_job;
       r.pid = launch(plan, job, program, per_job);
       r.started = r.last_report = Clock::now();
       running[i] = r;
@@ -171,10 +148,7 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
         } else {
           state[it->first] = State::Failed;
           ++sum.failed;
-          const std::string why = WIFEXITED(status) ? fmt::format("exit code {}", WEXITSTATUS(status))
-                                  : WIFSIGNALED(status) ? fmt::format("signal {}", WTERMSIG(status))
-                                                        : std::string("no result");
-          std::cout << fmt::format("FAILED {} ({}); the end of {}:\n{}", job_label(job), why, log_file(job),
+          std::cout << fmt::format("FAILED {} ({}); the end of {}:\n{}", job_label(job), exit_status_text(status), log_file(job),
                                    log_tail(job, 12))
                     << std::flush;
         }
@@ -186,19 +160,13 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
     // Progress of the running jobs.
     const auto now = Clock::now();
     for (auto& [i, r] : running) {
-      const Progress p = read_progress(plan.jobs[i]);
-      if (p.known && (r.first_done < 0 || p.label != r.label)) {
-        r.label = p.label;
-        r.first_done = p.done;
-        r.first_seen = now;
-      }
+      const Progress p = r.progress.look(plan.jobs[i]);
       if (o.quiet || std::chrono::duration<double>(now - r.last_report).count() < o.report_every) continue;
       r.last_report = now;
       std::string line = fmt::format("      {}: running {}", job_label(plan.jobs[i]),
                                      format_duration(std::chrono::duration<double>(now - r.started).count()));
       if (p.known) {
-        const double dt = std::chrono::duration<double>(now - r.first_seen).count();
-        const double rate = dt > 0 ? (p.done - r.first_done) / dt : 0;
+        const double rate = r.progress.rate();
         line += fmt::format(", {} {:.0f}/{:.0f}", p.label, p.done, p.total);
         if (rate > 0)
           line += fmt::format(", {:.2f}/s, {} left", rate, format_duration((p.total - p.done) / rate));

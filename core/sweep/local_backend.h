@@ -1,9 +1,10 @@
 // Runs a sweep's jobs on this machine (docs/sweeps.md): each job is `bimart sweep job DIR
 // KEY` (core/sweep/job_runner.h), started as a child process with its output in the job's
-// log.txt, up to `jobs` at once with the threads divided between them. Finished jobs (done.json with their
-// key) are skipped; an unfinished training continues from its checkpoint (train --resume)
-// and an unfinished generation keeps the windows it wrote (generate --resume). Children
-// are stopped with SIGTERM (and checkpoint) when the sweep is interrupted or killed.
+// log.txt, up to `jobs` at once with the threads divided between them. Finished jobs
+// (done.json with their key) are skipped; an unfinished training continues from its
+// checkpoint (train --resume) and an unfinished generation keeps the windows it wrote
+// (generate --resume). Children are stopped with SIGTERM (and checkpoint) when the sweep
+// is interrupted or killed.
 #pragma once
 
 #include <string>

@@ -247,6 +247,8 @@ struct Planner {
 
 }  // namespace
 
+std::string job_label(const Job& job) { return std::string(job_kind_name(job.kind)) + " " + job.name; }
+
 const char* job_kind_name(JobKind kind) {
   switch (kind) {
     case JobKind::Train: return "train";

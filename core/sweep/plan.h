@@ -36,6 +36,9 @@ struct Job {
   int nodes = 1, tasks_per_node = 1, cpus_per_task = 0;
 };
 
+// "train motion", "generate w C, NP-BPS": how progress lines and logs name a job.
+std::string job_label(const Job& job);
+
 struct RowPlan {
   std::string name, section, output;
   std::size_t generate = 0, eval = 0;  // job indices

@@ -1,14 +1,14 @@
 #include "core/sweep/slurm_backend.h"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <csignal>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -29,8 +29,6 @@ using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 std::string slurm_file(const Job& job) { return (fs::path(job.folder) / "slurm.json").string(); }
-std::string job_label(const Job& job) { return fmt::format("{} {}", job_kind_name(job.kind), job.name); }
-
 // "bimart-table3-train-npa_bps_motion": what squeue shows; Slurm allows most characters,
 // but spaces and commas in a row name would make the name awkward to use.
 std::string slurm_job_name(const Plan& plan, const Job& job) {
@@ -109,16 +107,9 @@ long submit(const Plan& plan, const Job& job, const SlurmOptions& o, const std::
     throw Error(fmt::format("sbatch refused {} ({}): {}\n  the command: {}", job_label(job),
                             r.exit_code == 0 ? "no job id in its answer" : fmt::format("exit code {}", r.exit_code),
                             trimmed(r.err.empty() ? r.out : r.err), join(argv, " ")));
-  const std::time_t now = std::time(nullptr);
-  char when[32];
-  std::strftime(when, sizeof when, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  const json j{{"id", id}, {"key", job.key}, {"submitted", when}, {"sbatch", argv}};
+  const json j{{"id", id}, {"key", job.key}, {"submitted", utc_now_text()}, {"sbatch", argv}};
   write_file_atomically(slurm_file(job), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
   return id;
-}
-
-bool state_failed(const std::string& state) {
-  return !slurm_state_live(state) && state != "COMPLETED";
 }
 
 }  // namespace
@@ -143,11 +134,17 @@ std::map<long, SlurmJobState> slurm_jobs() {
     std::stringstream ls(line);
     for (std::string p; std::getline(ls, p, '|');) f.push_back(trimmed(p));
     if (f.size() < 2) continue;
-    const long id = parse_job_id(f[0]);
-    if (id <= 0 || f[0].find_first_not_of("0123456789") != std::string::npos) continue;  // array tasks: not ours
-    jobs[id] = {f[1], f.size() > 2 ? f[2] : "", f.size() > 3 ? f[3] : ""};
+    if (f[0].empty() || f[0].find_first_not_of("0123456789") != std::string::npos) continue;  // array tasks: not ours
+    jobs[std::stol(f[0])] = {f[1], f.size() > 2 ? f[2] : "", f.size() > 3 ? f[3] : ""};
   }
   return jobs;
+}
+
+std::string slurm_state_text(const SlurmJobState& q) {
+  std::string s = q.state;
+  if (q.state == "PENDING" && !q.reason.empty() && q.reason != "None") s += " (" + q.reason + ")";
+  if (q.state == "RUNNING" && !q.nodes.empty()) s += " on " + q.nodes;
+  return s;
 }
 
 long submitted_id(const Job& job) {
@@ -213,7 +210,7 @@ RunSummary run_slurm(const Plan& plan, const SlurmOptions& o) {
   auto last_poll = Clock::now() - std::chrono::hours(1);
   while (ended.size() < watched.size() && !signals.stop_requested()) {
     if (std::chrono::duration<double>(Clock::now() - last_poll).count() < o.poll_seconds) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      ::usleep(200 * 1000);  // a signal ends it at once (EINTR)
       continue;
     }
     last_poll = Clock::now();
@@ -223,8 +220,25 @@ RunSummary run_slurm(const Plan& plan, const SlurmOptions& o) {
       const Job& job = plan.jobs[i];
       const auto it = queue.find(ids[i]);
       const std::string state = it == queue.end() ? "" : it->second.state;
-      if (is_done(job) && !slurm_state_live(state)) {
-        ended.insert(i);
+      if (slurm_state_live(state)) {
+        if (o.quiet) continue;
+        const std::string shown = slurm_state_text(it->second);
+        const auto now = Clock::now();
+        if (shown != last_state[i]) {
+          last_state[i] = shown;
+          last_report[i] = now;
+          std::cout << fmt::format("      {}: Slurm job {} {}\n", job_label(job), ids[i], shown) << std::flush;
+        } else if (state == "RUNNING" && std::chrono::duration<double>(now - last_report[i]).count() >= o.report_every) {
+          last_report[i] = now;
+          const Progress p = read_progress(job);
+          if (p.known)
+            std::cout << fmt::format("      {}: {} {:.0f}/{:.0f}\n", job_label(job), p.label, p.done, p.total) << std::flush;
+        }
+        continue;
+      }
+      // Ended, or forgotten by squeue.
+      ended.insert(i);
+      if (is_done(job)) {
         ++sum.ran;
         if (!o.quiet)
           std::cout << fmt::format("done  {} in {} (Slurm job {})\n", job_label(job),
@@ -232,36 +246,18 @@ RunSummary run_slurm(const Plan& plan, const SlurmOptions& o) {
                     << std::flush;
         continue;
       }
-      if (state.empty() || state_failed(state) || state == "COMPLETED") {
-        ended.insert(i);
-        // A job cancelled because a job it needs failed (--kill-on-invalid-dep) was skipped.
-        bool behind_failure = false;
-        for (const std::size_t d : job.deps) behind_failure = behind_failure || failed_jobs.count(d) > 0;
-        failed_jobs.insert(i);
-        if (behind_failure) {
-          ++sum.skipped;
-          if (!o.quiet) std::cout << fmt::format("skipped {}: a job it needs failed\n", job_label(job)) << std::flush;
-        } else {
-          ++sum.failed;
-          std::cout << fmt::format("FAILED {} (Slurm job {} {}); the end of {}:\n{}", job_label(job), ids[i],
-                                   state.empty() ? "no longer in squeue" : state, log_file(job), log_tail(job, 12))
-                    << std::flush;
-        }
-        continue;
-      }
-      if (o.quiet) continue;
-      const std::string shown = state + (state == "PENDING" ? " (" + it->second.reason + ")" : "") +
-                                (state == "RUNNING" ? " on " + it->second.nodes : "");
-      const auto now = Clock::now();
-      if (shown != last_state[i]) {
-        last_state[i] = shown;
-        last_report[i] = now;
-        std::cout << fmt::format("      {}: Slurm job {} {}\n", job_label(job), ids[i], shown) << std::flush;
-      } else if (state == "RUNNING" && std::chrono::duration<double>(now - last_report[i]).count() >= o.report_every) {
-        last_report[i] = now;
-        const Progress p = read_progress(job);
-        if (p.known)
-          std::cout << fmt::format("      {}: {} {:.0f}/{:.0f}\n", job_label(job), p.label, p.done, p.total) << std::flush;
+      // A job cancelled because a job it needs failed (--kill-on-invalid-dep) was skipped.
+      bool behind_failure = false;
+      for (const std::size_t d : job.deps) behind_failure = behind_failure || failed_jobs.count(d) > 0;
+      failed_jobs.insert(i);
+      if (behind_failure) {
+        ++sum.skipped;
+        if (!o.quiet) std::cout << fmt::format("skipped {}: a job it needs failed\n", job_label(job)) << std::flush;
+      } else {
+        ++sum.failed;
+        std::cout << fmt::format("FAILED {} (Slurm job {} {}); the end of {}:\n{}", job_label(job), ids[i],
+                                 state.empty() ? "no longer in squeue" : state, log_file(job), log_tail(job, 12))
+                  << std::flush;
       }
     }
   }

@@ -41,6 +41,8 @@ struct SlurmJobState {
   std::string reason;  // why it is pending (Dependency, Resources, ...)
   std::string nodes;   // where it runs
 };
+// "PENDING (Dependency)", "RUNNING on n12", "CANCELLED".
+std::string slurm_state_text(const SlurmJobState& state);
 // The jobs squeue lists for this user (finished ones only for a few minutes), by id.
 std::map<long, SlurmJobState> slurm_jobs();
 // The id of the Slurm job last submitted for `job` (its slurm.json), 0 when none.

@@ -12,13 +12,15 @@ struct CliRun {
   std::string output;  // stdout and stderr
 };
 
-inline CliRun run_bimart(const std::string& args) {
-  const std::string cmd = std::string(BIMART_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
+// Runs a shell command line and collects its stdout and stderr.
+inline CliRun run_shell(const std::string& command) {
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
   std::string out;
   char buf[4096];
   while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
   return {pclose(p), out};
 }
+
+inline CliRun run_bimart(const std::string& args) { return run_shell(std::string(BIMART_CLI) + " " + args); }
 
 }  // namespace bimart::test

@@ -29,23 +29,15 @@ using test::exit_code;
 using test::read_text;
 
 const fs::path& scratch() {
-  static const fs::path d = [] {
-    const fs::path p = fs::temp_directory_path() / ("bimart_slurm_tests_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-  }();
+  static const fs::path d = test::fresh_scratch_folder("bimart_slurm_tests_");
   return d;
 }
 
+// The output of a shell command line (its exit code in *status).
 std::string run_shell(const std::string& cmd, int* status = nullptr) {
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (size_t n = fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int s = pclose(p);
-  if (status != nullptr) *status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  return out;
+  const test::CliRun r = test::run_shell(cmd);
+  if (status != nullptr) *status = exit_code(r);
+  return r.output;
 }
 
 std::string cluster_script() { return std::string(BIMART_SOURCE_DIR) + "/tests/sweep/slurm_cluster.sh"; }

@@ -26,12 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path& scratch() {
-  static const fs::path d = [] {
-    const fs::path p = fs::temp_directory_path() / ("bimart_sweep_tests_" + std::to_string(::getpid()));
-    fs::remove_all(p);
-    fs::create_directories(p);
-    return p;
-  }();
+  static const fs::path d = test::fresh_scratch_folder("bimart_sweep_tests_");
   return d;
 }
 

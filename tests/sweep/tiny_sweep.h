@@ -4,6 +4,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,14 @@
 namespace bimart::test {
 
 namespace tiny_fs = std::filesystem;
+
+// An empty folder of this test process under the temporary folder: PREFIX + pid.
+inline tiny_fs::path fresh_scratch_folder(const std::string& prefix) {
+  const tiny_fs::path p = tiny_fs::temp_directory_path() / (prefix + std::to_string(::getpid()));
+  tiny_fs::remove_all(p);
+  tiny_fs::create_directories(p);
+  return p;
+}
 
 inline int exit_code(const CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
 
