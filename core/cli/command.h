@@ -32,4 +32,5 @@ void add_generate_commands(CLI::App& app, Commands& out);  // generate
 void add_export_commands(CLI::App& app, Commands& out);    // export, view, render
 void add_model_commands(CLI::App& app, Commands& out);     // model check
 void add_sweep_commands(CLI::App& app, Commands& out);     // sweep, sweep status
+void add_edit_commands(CLI::App& app, Commands& out);      // edit
 }  // namespace bimart::cli

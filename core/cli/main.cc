@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   bimart::cli::add_export_commands(app, commands);
   bimart::cli::add_model_commands(app, commands);
   bimart::cli::add_sweep_commands(app, commands);
+  bimart::cli::add_edit_commands(app, commands);
 
   bimart::runtime::set_threads(0);  // all cores, also for what --version reports
   return bimart::cli::run_commands(app, commands, argc, argv, [&](const bimart::cli::Command& c) {

@@ -39,7 +39,8 @@ void ContactMapGuidance::set_release(int steps) {
   release_steps_ = steps;
 }
 
-void ContactMapGuidance::set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach) {
+void ContactMapGuidance::set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach,
+                                     at::Tensor may_hold, at::Tensor may_hold_top) {
   const auto N = points_.size(0);
   if (static_cast<std::int64_t>(held.size()) != N || static_cast<std::int64_t>(turning.size()) != N ||
       top.dim() != 2 || top.size(0) != N || top.size(1) != points_.size(1))
@@ -52,6 +53,8 @@ void ContactMapGuidance::set_support(std::vector<bool> held, std::vector<bool> t
   turning_ = std::move(turning);
   top_ = top.to(at::kBool).contiguous();
   reach_ = reach;
+  may_hold_ = std::move(may_hold);
+  may_hold_top_ = std::move(may_hold_top);
 }
 
 namespace {
@@ -165,8 +168,10 @@ at::Tensor ContactMapGuidance::placement(const at::Tensor& x0, std::int64_t firs
   at::Tensor delta = contact_translations(H, P, targets(first, T, B), placement_);
   if (support_) {
     const auto frames = [&](const std::vector<bool>& v) { return std::vector<bool>(v.begin() + first, v.begin() + first + T); };
+    const auto window = [&](const at::Tensor& m) { return m.defined() ? m.slice(0, first, first + T) : m; };
     delta = delta + support_translations(H + delta.unsqueeze(3), P, frames(held_), frames(turning_),
-                                         top_.slice(0, first, first + T), reach_, placement_.sigma);
+                                         top_.slice(0, first, first + T), reach_, placement_.sigma,
+                                         window(may_hold_), window(may_hold_top_));
   }
   const at::Tensor step_h = delta.unsqueeze(3).expand({B, T, 2, kHandKeypoints, 3}).reshape({B, T, 600});
   return at::cat({step_h, -step_h}, -1).to(x0.scalar_type());  // H moves, H + D stays

@@ -33,8 +33,10 @@ class ContactMapGuidance : public Guidance {
   void set_placement(int steps, const PlacementOptions& options = {});
   // With the placement, also put a hand on the object where it must be held and none is
   // (core/diffusion/contact_support.h, support_translations): `held` and `turning` per frame
-  // (N each), `top` [N, 1024] bool (the point lies on the top part), `reach` m.
-  void set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach);
+  // (N each), `top` [N, 1024] bool (the point lies on the top part), `reach` m; may_hold,
+  // may_hold_top [N, 2] bool (optional): the hands that may be put there (docs/directing.md).
+  void set_support(std::vector<bool> held, std::vector<bool> turning, at::Tensor top, double reach,
+                   at::Tensor may_hold = {}, at::Tensor may_hold_top = {});
   // No gradient correction at the last `steps` diffusion steps (t < steps; 0 = every step,
   // the paper's): the denoiser's last predictions re-form the hands the correction bent.
   void set_release(int steps);
@@ -61,6 +63,7 @@ class ContactMapGuidance : public Guidance {
   bool support_ = false;
   std::vector<bool> held_, turning_;
   at::Tensor top_;  // [N, 1024] bool
+  at::Tensor may_hold_, may_hold_top_;  // [N, 2] bool or undefined
   double reach_ = 0.01;
   int release_steps_ = 0;
 };

@@ -19,12 +19,23 @@ at::Tensor frame_mask(const std::vector<bool>& v) {
   return m;
 }
 
+// [N, 2] bool: every hand may, unless `may` says otherwise.
+at::Tensor eligible(const at::Tensor& may, std::int64_t N) {
+  if (!may.defined()) return at::ones({N, 2}, at::kBool);
+  if (may.dim() != 2 || may.size(0) != N || may.size(1) != 2)
+    throw Error("contact support: the hands that may hold must be [" + std::to_string(N) + ", 2], got " +
+                c10::str(may.sizes()));
+  return may.to(at::kBool);
+}
+
 // In frames `need` [N] where no hand's map restricted to `where` [N, M] comes below the
-// threshold, the nearest hand's entries on `where` are shifted down by their minimum.
-at::Tensor shift_nearest(const at::Tensor& C, const at::Tensor& need, const at::Tensor& where, double threshold) {
+// threshold, the nearest hand (among those `may` [N, 2]) has its entries on `where`
+// shifted down by their minimum.
+at::Tensor shift_nearest(const at::Tensor& C, const at::Tensor& need, const at::Tensor& where, double threshold,
+                         const at::Tensor& may) {
   const at::Tensor w = where.unsqueeze(0).unsqueeze(2);                                     // [1, N, 1, M]
   const at::Tensor masked = C.masked_fill(~w, std::numeric_limits<float>::infinity());
-  const at::Tensor mins = std::get<0>(masked.min(-1));                                    // [S, N, 2]
+  const at::Tensor mins = std::get<0>(masked.min(-1)).masked_fill(~may.unsqueeze(0), std::numeric_limits<float>::infinity());  // [S, N, 2]
   const at::Tensor untouched = (mins >= threshold).all(-1) & need.unsqueeze(0);          // [S, N]
   const at::Tensor nearest = at::one_hot(mins.argmin(-1), 2).to(at::kBool);              // [S, N, 2]
   const at::Tensor shift = at::where(nearest & untouched.unsqueeze(-1) & at::isfinite(mins), mins,
@@ -38,7 +49,8 @@ constexpr int kSupportKeypoint = 3;  // a hand's distance is its 3rd nearest key
 }  // namespace
 
 at::Tensor hold_contacts(const at::Tensor& maps, const std::vector<bool>& held, const std::vector<bool>& turning,
-                         const at::Tensor& top, double threshold) {
+                         const at::Tensor& top, double threshold, const at::Tensor& may_hold,
+                         const at::Tensor& may_hold_top) {
   if (maps.dim() != 4 || maps.size(2) != 2 || top.dim() != 2 || top.size(0) != maps.size(1) ||
       top.size(1) != maps.size(3) || static_cast<std::int64_t>(held.size()) != maps.size(1) ||
       static_cast<std::int64_t>(turning.size()) != maps.size(1))
@@ -48,13 +60,15 @@ at::Tensor hold_contacts(const at::Tensor& maps, const std::vector<bool>& held, 
   if (!(threshold > 0)) throw Error("contact support: threshold must be > 0 (metres)");
   const at::Tensor is_top = top.to(at::kBool);
   at::Tensor C = maps.to(at::kFloat);
-  C = shift_nearest(C, frame_mask(held), at::ones_like(is_top), threshold);
-  return shift_nearest(C, frame_mask(turning), is_top, threshold).contiguous();
+  const std::int64_t N = maps.size(1);
+  C = shift_nearest(C, frame_mask(held), at::ones_like(is_top), threshold, eligible(may_hold, N));
+  return shift_nearest(C, frame_mask(turning), is_top, threshold, eligible(may_hold_top, N)).contiguous();
 }
 
 at::Tensor support_translations(const at::Tensor& keypoints, const at::Tensor& object_points,
                                 const std::vector<bool>& held, const std::vector<bool>& turning, const at::Tensor& top,
-                                double reach, double sigma) {
+                                double reach, double sigma, const at::Tensor& may_hold,
+                                const at::Tensor& may_hold_top) {
   const at::Tensor H = keypoints.to(at::kFloat);
   const at::Tensor P = object_points.to(at::kFloat);
   if (H.dim() != 5 || H.size(2) != 2 || H.size(4) != 3 || P.dim() != 3 || P.size(0) != H.size(1) || P.size(2) != 3 ||
@@ -68,15 +82,18 @@ at::Tensor support_translations(const at::Tensor& keypoints, const at::Tensor& o
   const std::int64_t B = H.size(0), T = H.size(1), J = H.size(3), M = P.size(1);
   const float inf = std::numeric_limits<float>::infinity();
   const at::Tensor is_top = top.to(at::kBool);
-  const std::pair<at::Tensor, at::Tensor> passes[] = {{frame_mask(held), at::ones_like(is_top)},
-                                                      {frame_mask(turning), is_top}};
+  struct Pass {
+    at::Tensor need_frame, where, may;
+  };
+  const Pass passes[] = {{frame_mask(held), at::ones_like(is_top), eligible(may_hold, T)},
+                         {frame_mask(turning), is_top, eligible(may_hold_top, T)}};
   // Smoothing shortens the moves near the ends of a stretch and between frames whose
   // nearest points differ, so the frames still apart are moved again (a few rounds).
   at::Tensor total = at::zeros({B, T, 2, 3}, at::kFloat);
   for (int round = 0; round < kSupportRounds; ++round) {
     at::Tensor delta = at::zeros({B, T, 2, 3}, at::kFloat);
     at::Tensor w = at::zeros({B, T, 2}, at::kFloat);
-    for (const auto& [need_frame, where] : passes) {
+    for (const auto& [need_frame, where, may] : passes) {
       const at::Tensor Hd = H + (total + delta).unsqueeze(3);
       // Each keypoint's nearest object point (among `where`), sample by sample.
       at::Tensor gap = at::empty({B, T, 2, J}, at::kFloat), near = at::empty({B, T, 2, J}, at::kLong);
@@ -88,7 +105,8 @@ at::Tensor support_translations(const at::Tensor& keypoints, const at::Tensor& o
       }
       // A hand's distance: its k-th nearest keypoint's (not the nearest: a stray keypoint
       // far from the others is not where the fitted hand will be).
-      const auto [hand_gap, kp] = gap.kthvalue(std::min<std::int64_t>(kSupportKeypoint, J), -1);  // [B, T, 2]
+      auto [hand_gap, kp] = gap.kthvalue(std::min<std::int64_t>(kSupportKeypoint, J), -1);  // [B, T, 2]
+      hand_gap = hand_gap.masked_fill(~may.unsqueeze(0), inf);
       const at::Tensor need = (hand_gap >= reach).all(-1) & need_frame.view({1, T}) & at::isfinite(hand_gap).any(-1);
       const at::Tensor move = at::one_hot(hand_gap.argmin(-1), 2).to(at::kBool) & need.unsqueeze(-1);  // [B, T, 2]
       const at::Tensor k = Hd.gather(3, kp.view({B, T, 2, 1, 1}).expand({B, T, 2, 1, 3})).squeeze(3);

@@ -126,7 +126,8 @@ struct WindowLayout {
 }  // namespace
 
 at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, const at::Tensor& C,
-                                    const Guidance* guidance, const GenerateOptions& o, at::Generator gen) const {
+                                    const Guidance* guidance, const GenerateOptions& o, at::Generator gen,
+                                    const SampleConstraint* constraint) const {
   c10::InferenceMode inference;
   const ModelInfo& info = checkpoint_.info;
   const NormalizationStats& st = info.normalization;
@@ -141,6 +142,9 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   if (mano && guidance != nullptr)
     throw Error(path_ + ": guidance corrects keypoints X = [H | D], but this model samples the MANO representation "
                 "(MANO-Rep): run it without a guidance stage");
+  if (mano && constraint != nullptr)
+    throw Error(path_ + ": pinned hands are imposed on keypoints X = [H | D], but this model samples the MANO "
+                "representation (MANO-Rep): use a keypoint motion model (motion.diffusion) to direct the hands");
   at::Tensor contact;
   if (motion && o.use_contact) {
     if (!C.defined()) throw Error(path_ + ": the motion model needs contact maps (or use_contact off)");
@@ -191,6 +195,17 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
     }
     return st.normalize_x(metres + at::cat(corr, 0));
   };
+  // The constraint imposed on x0 (normalised) window by window, in the model's units.
+  const auto constrain = [&](const at::Tensor& x0, int t) {
+    std::vector<at::Tensor> parts;
+    for (std::int64_t k = 0; k < K; ++k) {
+      const at::Tensor w = x0.slice(0, k * S, (k + 1) * S);
+      const at::Tensor units = motion ? st.denormalize_x(w) : st.contact_from_sample(w).flatten(-2);
+      const at::Tensor fixed = constraint->impose(units, lay.spans[k].first, t, schedule_.steps);
+      parts.push_back(motion ? st.normalize_x(fixed) : st.contact_sample(fixed.unflatten(-1, {2, 1024})));
+    }
+    return at::cat(parts, 0).to(x0.scalar_type());
+  };
   const auto predict = [&](const at::Tensor& x_t, int t) {
     const at::Tensor xin = cfg ? at::cat({x_t, x_t}, 0) : x_t;
     const at::Tensor out = predict_x0(*net_, schedule_, xin, at::full({xin.size(0)}, t, at::kLong), cond_emb);
@@ -199,14 +214,20 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
     if (cfg) x0 = combine_cfg(x0, out.slice(0, B, 2 * B), o.cfg_lambda);
     x0 = band_limit(x0, band);
     if (guidance != nullptr && motion) x0 = guide(x0, t, &Guidance::placement);
+    if (constraint != nullptr) x0 = constrain(x0, t);
     return agree(x0);
   };
   // One noise per sequence frame, so shared frames start equal; fused again after every step.
   const at::Tensor noise = lay.split(at::randn({S, N, D}, gen));
   const StepHook hook = [&](int, int, at::Tensor& x) { x = agree(x); };
   const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, hook));
-  if (!motion) return st.contact_from_sample(result).clamp_min(0.0);
-  return mano ? st.denormalize_mano(result) : st.denormalize_x(result);
+  if (mano) return st.denormalize_mano(result);
+  at::Tensor out = motion ? st.denormalize_x(result) : st.contact_from_sample(result).clamp_min(0.0);
+  if (constraint == nullptr) return out;
+  // Exactly on the result too (the contact basis cannot hold every imposed value).
+  const at::Tensor flat = motion ? out : out.flatten(-2);
+  const at::Tensor fixed = constraint->impose(flat, 0, -1, schedule_.steps);
+  return motion ? fixed : fixed.unflatten(-1, {2, 1024});
 }
 
 }  // namespace bimart::diffusion

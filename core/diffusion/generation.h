@@ -19,6 +19,7 @@
 #include "core/diffusion/sampler.h"
 #include "core/diffusion/schedule.h"
 #include "stages/guidance.h"
+#include "stages/sample_constraint.h"
 
 namespace bimart::diffusion {
 
@@ -52,9 +53,12 @@ class DiffusionModel {
   // Returns, denormalised: contact model C [S, N, 2, 1024] (m, clamped at 0); motion
   // model X [S, N, 1200] (m, canonical frame), or for a MANO-Rep model (which takes no
   // guidance) its sample [S, N, 294] (core/features/mano_representation.h).
+  // `constraint` (optional) is imposed on every step's clean-sample prediction, after the
+  // guidance, and on the result: contact model on C [B, T, 2048] (m), motion model on X
+  // (stages/sample_constraint.h); a MANO-Rep model takes none.
   at::Tensor generate(const at::Tensor& object_features, const at::Tensor& global_states,
                       const at::Tensor& contact_maps, const Guidance* guidance, const GenerateOptions& options,
-                      at::Generator gen) const;
+                      at::Generator gen, const SampleConstraint* constraint = nullptr) const;
 
   // The windows [start, start + length) covering N frames with the given overlap: starts
   // 0, W - overlap, ..., the last aligned to the end; one window [0, N) when N <= W.

@@ -1,11 +1,13 @@
 #include "core/refine/refinement.h"
 
 #include <ceres/ceres.h>
+#include <ceres/rotation.h>
 
 #include <algorithm>
 #include <chrono>
 #include <map>
 #include <cmath>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "core/features/hand_features.h"
 #include "core/geometry/point_guard.h"
 #include "core/hand/keypoints.h"
+#include "core/hand/lbs.h"
 #include "core/hand/lbs_subset.h"
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
@@ -41,6 +44,7 @@ struct FrameTerms {
   std::vector<int> pen_rows;    // subset rows with a penetration plane
   std::vector<Plane> pen;       // their planes
   std::vector<double> pen_scale;  // their residual scales (s_pen × the vertex's boost)
+  std::vector<double> pen_offset;  // m their planes are moved out by (the frame's clearance)
   std::array<Plane, kJ> proj;   // per keypoint: the plane nearest K + D̂
   std::vector<double> pos, jac;  // posed [3S] and d/dx [3S × 51] at the current point
   int hold_k = -1;               // held frame: the keypoint pulled onto the surface
@@ -60,6 +64,13 @@ struct HandData {
   std::vector<int> hold_part;  // per frame: -1, or the ObjectPart this hand is held to
   // Per frame: the penetration weight multiplier (grows while the frame stays too deep).
   std::vector<double> pen_boost;
+  // Directions (RefineDirections): per frame clearance (m) and kept flags, the pins, the
+  // wrist joint of the rest hand with this β (the wrist is at trans + j0), √(2 w_pin).
+  std::vector<double> clearance;
+  std::vector<bool> kept;
+  std::vector<RefineDirections::Pin> pins;
+  Eigen::Vector3d j0 = Eigen::Vector3d::Zero();
+  double s_pin = 0;
 };
 
 // Poses every frame once per evaluation point, with Jacobians when asked.
@@ -176,13 +187,15 @@ class FrameCost : public ceres::CostFunction {
         r[row] = d_->s_fit * (f.pos[static_cast<size_t>(3 * k + c)] - H[3 * k + c]);
         if (J) write_row(jac_row(f, k, c), d_->s_fit, blocks_, row, J);
       }
+    // A frame the hand keeps off the object has no contacts to project onto.
+    const double s_proj = d_->clearance[static_cast<size_t>(t_)] > 0 ? 0.0 : d_->s_proj;
     for (int k : kps_) {
       const Plane& p = f.proj[static_cast<size_t>(k)];
       const Eigen::Vector3d P(f.pos[3 * k] + D[3 * k], f.pos[3 * k + 1] + D[3 * k + 1], f.pos[3 * k + 2] + D[3 * k + 2]);
-      r[row] = d_->s_proj * p.normal.dot(P - p.point);
+      r[row] = s_proj * p.normal.dot(P - p.point);
       if (J) {
         normal_row(f, k, p.normal, n_row);
-        write_row(n_row, d_->s_proj, blocks_, row, J);
+        write_row(n_row, s_proj, blocks_, row, J);
       }
       ++row;
     }
@@ -190,7 +203,7 @@ class FrameCost : public ceres::CostFunction {
       const int s = f.pen_rows[static_cast<size_t>(i)];
       const Plane& p = f.pen[static_cast<size_t>(i)];
       const Eigen::Vector3d v(f.pos[3 * s], f.pos[3 * s + 1], f.pos[3 * s + 2]);
-      const double depth = p.normal.dot(p.point - v);
+      const double depth = p.normal.dot(p.point - v) + f.pen_offset[static_cast<size_t>(i)];
       const double scale = f.pen_scale[static_cast<size_t>(i)];
       r[row] = depth > 0 ? scale * depth : 0.0;
       if (J) {
@@ -270,6 +283,74 @@ class HoldCost : public ceres::CostFunction {
   std::vector<Block> blocks_;
 };
 
+// A pinned wrist: r = s (trans + j0 − wrist) on the translation block.
+class WristPinCost : public ceres::SizedCostFunction<3, 3> {
+ public:
+  WristPinCost(Eigen::Vector3d target, double s) : target_(std::move(target)), s_(s) {}
+  bool Evaluate(double const* const* x, double* r, double** J) const override {
+    for (int c = 0; c < 3; ++c) r[c] = s_ * (x[0][c] - target_[c]);
+    if (J && J[0])
+      for (int i = 0; i < 9; ++i) J[0][i] = i % 4 == 0 ? s_ : 0.0;
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d target_;  // the pin minus j0: what trans must be
+  double s_;
+};
+
+// A pinned orientation: r = s · log(R_pin^T R(rot)) as an axis-angle vector.
+struct RotationPin {
+  Eigen::Matrix3d pin;
+  double s;
+  template <class T>
+  bool operator()(const T* aa, T* r) const {
+    T R[9], M[9];
+    ceres::AngleAxisToRotationMatrix(aa, ceres::RowMajorAdapter3x3(R));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        M[3 * i + j] = T(0);
+        for (int k = 0; k < 3; ++k) M[3 * i + j] += pin(k, i) * R[3 * k + j];
+      }
+    ceres::RotationMatrixToAngleAxis(ceres::RowMajorAdapter3x3(static_cast<const T*>(M)), r);
+    for (int c = 0; c < 3; ++c) r[c] *= s;
+    return true;
+  }
+};
+
+// A pinned finger (its three joints): r = s (θ − θ_pin) on its block.
+class FingerPinCost : public ceres::SizedCostFunction<9, 9> {
+ public:
+  FingerPinCost(const double* target, double s) : s_(s) { std::copy(target, target + 9, target_); }
+  bool Evaluate(double const* const* x, double* r, double** J) const override {
+    for (int c = 0; c < 9; ++c) r[c] = s_ * (x[0][c] - target_[c]);
+    if (J && J[0])
+      for (int i = 0; i < 81; ++i) J[0][i] = i % 10 == 0 ? s_ : 0.0;
+    return true;
+  }
+
+ private:
+  double target_[9];
+  double s_;
+};
+
+// The pins' cost w_pin · Σ (wrist², rotation², fingers²) at the current x.
+double pin_cost(const HandData& d, double w_pin) {
+  double sum = 0;
+  for (const RefineDirections::Pin& p : d.pins) {
+    const double* x = d.x.data() + p.frame * kX;
+    sum += (Eigen::Vector3d(x[48], x[49], x[50]) + d.j0 - p.wrist).squaredNorm();
+    if (p.rotation) {
+      double r[3];
+      RotationPin{*p.rotation, 1.0}(x, r);
+      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    }
+    if (p.fingers)
+      for (int i = 0; i < 45; ++i) sum += std::pow(x[3 + i] - (*p.fingers)[i], 2);
+  }
+  return w_pin * sum;
+}
+
 Points3 pose_all(const LbsSubset& all, const double* x, const double* beta) {
   Points3 v(all.size(), 3);
   lbs_subset(all, x, x + 3, x + 48, beta, v.data());
@@ -322,8 +403,9 @@ struct Evaluation {
 
 // The cost's terms with exact distances at the current x; optionally re-linearises.
 // With `grow`, frames deeper than the tolerance get their penetration weight multiplied.
+// In a frame with a clearance c, depths are measured from the surface moved out by c.
 Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dist,
-                    const RefineOptions& o, bool relinearise, bool grow = false) {
+                    const RefineOptions& o, bool relinearise, bool grow = false, double w_pin = 0) {
   const int64_t N = d->N;
   const int V = all.size();
   Evaluation e;
@@ -335,13 +417,14 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     const double* H = d->H.data() + t * 3 * kJ;
     const double* D = d->D.data() + t * 3 * kJ;
     FrameTerms* f = relinearise ? &d->frames[static_cast<size_t>(t)] : nullptr;
+    const double clear = d->clearance[static_cast<size_t>(t)];
     for (int k = 0; k < kJ; ++k) {
       const Eigen::Vector3d K = v.row(d->kp_ids[static_cast<size_t>(k)]).transpose();
       const Eigen::Vector3d Ht(H[3 * k], H[3 * k + 1], H[3 * k + 2]), Dt(D[3 * k], D[3 * k + 1], D[3 * k + 2]);
       fit += (K - Ht).squaredNorm();
       kerr += (K - Ht).norm();
       const ObjectSurfaceQuery q = dist.query(st, K + Dt);
-      proj += q.signed_distance * q.signed_distance;
+      if (clear == 0) proj += q.signed_distance * q.signed_distance;
       if (f) f->proj[static_cast<size_t>(k)] = plane_of(q);
     }
     if (d->hold_part[static_cast<size_t>(t)] >= 0) {  // the keypoint nearest the part
@@ -358,12 +441,13 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
         f->hold = plane_of(best);
       }
     }
-    const auto near = dist.near_surface(st, v, relinearise ? o.pen_margin : 0.0);
+    const auto near = dist.near_surface(st, v, (relinearise ? o.pen_margin : 0.0) + clear);
     for (const auto& [i, q] : near)
-      if (q.signed_distance > 0) {
-        pen += q.signed_distance * q.signed_distance;
-        if (q.signed_distance > e.max_depth) {
-          e.max_depth = q.signed_distance;
+      if (q.signed_distance + clear > 0) {
+        const double depth = q.signed_distance + clear;
+        pen += depth * depth;
+        if (depth > e.max_depth) {
+          e.max_depth = depth;
           e.deepest_frame = t;
           e.deepest_vertex = i;
         }
@@ -392,8 +476,9 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     f->pen_rows.clear();
     f->pen.clear();
     f->pen_scale.clear();
+    f->pen_offset.clear();
     double frame_depth = 0;
-    for (const auto& [i, q] : near) frame_depth = std::max(frame_depth, q.signed_distance);
+    for (const auto& [i, q] : near) frame_depth = std::max(frame_depth, q.signed_distance + clear);
     double& boost = d->pen_boost[static_cast<size_t>(t)];
     if (grow && frame_depth > o.pen_tolerance) boost *= o.pen_growth;
     e.max_boost = std::max(e.max_boost, boost);
@@ -406,6 +491,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
       const bool turn = q.signed_distance > 0 && !exit.isZero() && q.normal.dot(exit) < 0;
       f->pen.push_back(turn ? exit_plane(dist, st, v.row(i).transpose(), exit) : plane_of(q));
       f->pen_scale.push_back(d->s_pen * boost);
+      f->pen_offset.push_back(clear);
     }
     f->sub = LbsSubset::from(*d->model, ids);
   }
@@ -417,12 +503,14 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   e.terms.pen = o.w_pen * pen / nk;
   e.terms.fit = o.w_fit * fit / nk;
   e.terms.hold = o.w_hold * hold / static_cast<double>(N);
+  e.terms.pin = pin_cost(*d, w_pin);
   e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
   e.keypoint_error = kerr / nk;
   return e;
 }
 
-void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o, RefineHandReport* rep) {
+void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o, RefineHandReport* rep,
+                 double w_pin) {
   const auto t0 = std::chrono::steady_clock::now();
   const int V = d->model->num_vertices();
   std::vector<int> all_ids(static_cast<size_t>(V));
@@ -438,12 +526,13 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
 
   auto timed_evaluate = [&](bool relinearise, bool grow) {
     const auto s0 = std::chrono::steady_clock::now();
-    Evaluation ev = evaluate(d, all, dist, o, relinearise, grow);
+    Evaluation ev = evaluate(d, all, dist, o, relinearise, grow, w_pin);
     rep->surface_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
     return ev;
   };
   d->s_pen = std::sqrt(2 * o.w_pen / nk);
   d->s_hold = std::sqrt(2 * o.w_hold / static_cast<double>(d->N));
+  d->s_pin = std::sqrt(2 * w_pin);
   for (int p : d->hold_part) rep->held_frames += p >= 0;
   d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
@@ -486,10 +575,28 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         problem.AddResidualBlock(new AccelCost(d, t, blocks, rows), nullptr, p);
       }
     }
+    for (const RefineDirections::Pin& p : d->pins) {
+      double* x = d->x.data() + p.frame * kX;
+      problem.AddResidualBlock(new WristPinCost(p.wrist - d->j0, d->s_pin), nullptr, x + 48);
+      if (p.rotation)
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPin, 3, 3>(new RotationPin{*p.rotation, d->s_pin}),
+                                 nullptr, x);
+      if (p.fingers)
+        for (int g = 0; g < 5; ++g)
+          problem.AddResidualBlock(new FingerPinCost(p.fingers->data() + 9 * g, d->s_pin), nullptr, x + 3 + 9 * g);
+    }
+    // Kept frames stay as they started: every block of theirs constant.
+    for (int64_t t = 0; t < d->N; ++t) {
+      if (d->kept.empty() || !d->kept[static_cast<size_t>(t)]) continue;
+      double* x = d->x.data() + t * kX;
+      for (const Block& b : blocks_of(0x1f))
+        if (problem.HasParameterBlock(x + b.offset)) problem.SetParameterBlockConstant(x + b.offset);
+    }
     // Bounds keep a hand that the penetration boost pushes hard from winding its joints
     // round and round (generated keypoints 5 cm deep once drove a finger angle to 1,100 rad):
     // each finger axis-angle component within ±π, the root's within ±2π.
     for (int64_t t = 0; t < d->N; ++t) {
+      if (!d->kept.empty() && d->kept[static_cast<size_t>(t)]) continue;
       double* x = d->x.data() + t * kX;
       for (const Block& b : blocks_of(0x1f)) {
         if (b.offset == 48 || !problem.HasParameterBlock(x + b.offset)) continue;  // translation: free
@@ -536,7 +643,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
 // whole object for a hand chosen twice.
 void assign_holds(const std::array<const HandModel*, 2>& models, const ObjectDistance& dist,
                   const std::vector<ObjectState>& states, const HandMotion& start, const HeldFrames& held,
-                  const RefineOptions& o, std::array<HandData, 2>* data) {
+                  const RefineOptions& o, const RefineDirections& directions, std::array<HandData, 2>* data) {
   const std::size_t N = states.size();
   for (HandData& d : *data) d.hold_part.assign(N, -1);
   if (o.w_hold == 0 || (held.held.empty() && held.turning.empty())) return;
@@ -548,17 +655,46 @@ void assign_holds(const std::array<const HandModel*, 2>& models, const ObjectDis
   const auto Vn = static_cast<Eigen::Index>(V.size(2));
   const std::pair<ObjectPart, const std::vector<bool>*> passes[] = {{ObjectPart::Whole, &held.held},
                                                                     {ObjectPart::Top, &held.turning}};
+  const auto may = [&](ObjectPart part, std::size_t t, int h) {
+    const at::Tensor& m = part == ObjectPart::Top ? directions.may_hold_top : directions.may_hold;
+    return !m.defined() || m[static_cast<int64_t>(t)][h].item<bool>();
+  };
   for (std::size_t t = 0; t < N; ++t)
     for (const auto& [part, flags] : passes) {
       if (flags->empty() || !(*flags)[t]) continue;
+      if (!directions.kept.empty() && directions.kept[t]) continue;
       double sd[2];
       for (int h = 0; h < 2; ++h) {
         const Eigen::Map<const Points3> v(V[h][static_cast<int64_t>(t)].data_ptr<double>(), Vn, 3);
-        sd[h] = dist.max_signed_distance(states[t], v, part);
+        sd[h] = may(part, t, h) ? dist.max_signed_distance(states[t], v, part) : -std::numeric_limits<double>::infinity();
       }
+      if (!may(part, t, 0) && !may(part, t, 1)) continue;
       int& p = (*data)[sd[0] >= sd[1] ? 0 : 1].hold_part[t];
       if (part == ObjectPart::Top || p < 0) p = static_cast<int>(part);
     }
+}
+
+// The directions for hand h into its data, checked against its N frames.
+void apply_directions(const RefineDirections& r, int h, HandData* d) {
+  const std::size_t N = static_cast<std::size_t>(d->N);
+  const auto& clear = r.clearance[static_cast<size_t>(h)];
+  if (!clear.empty() && clear.size() != N)
+    throw Error(fmt::format("refinement: {} clearances for {} frames", clear.size(), N));
+  if (!r.kept.empty() && r.kept.size() != N) throw Error(fmt::format("refinement: {} kept flags for {} frames", r.kept.size(), N));
+  for (const at::Tensor* m : {&r.may_hold, &r.may_hold_top})
+    if (m->defined() && (m->dim() != 2 || m->size(0) != d->N || m->size(1) != 2))
+      throw Error("refinement: the hands that may hold must be [" + std::to_string(N) + ", 2], got " + c10::str(m->sizes()));
+  d->clearance = clear.empty() ? std::vector<double>(N, 0.0) : clear;
+  d->kept = r.kept;
+  d->pins = r.pins[static_cast<size_t>(h)];
+  for (const auto& p : d->pins)
+    if (p.frame < 0 || p.frame >= d->N || (p.fingers && p.fingers->size() != 45))
+      throw Error(fmt::format("refinement: a pin at frame {} of {} frames (with {} finger values)", p.frame, N,
+                              p.fingers ? p.fingers->size() : 45));
+  if (!(r.w_pin >= 0) || !std::isfinite(r.w_pin)) throw Error("refinement: w_pin must be a finite number >= 0");
+  const Eigen::VectorXd zero_pose = Eigen::VectorXd::Zero(HandModel::kPoseDim);
+  const Eigen::VectorXd beta = Eigen::Map<const Eigen::VectorXd>(d->beta.data(), HandModel::kNumBetas);
+  d->j0 = lbs<double>(*d->model, Eigen::Vector3d::Zero(), zero_pose, Eigen::Vector3d::Zero(), beta).joints.row(0).transpose();
 }
 
 std::vector<double> as_vector(const at::Tensor& t) {
@@ -591,7 +727,8 @@ void RefineOptions::validate() const {
 
 HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const ObjectDistance& distance, const at::Tensor& states,
                         const at::Tensor& keypoints, const HandMotion& start,
-                        const RefineOptions& options, RefineReport* report, const HeldFrames& held) {
+                        const RefineOptions& options, RefineReport* report, const HeldFrames& held,
+                        const RefineDirections& directions) {
   options.validate();
   const int64_t N = start.num_frames();
   if (N < 1) throw Error("refinement: the starting motion has no frames");
@@ -617,10 +754,12 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
     for (int64_t t = 0; t < N; ++t) d.states.push_back(ObjectState::from_row(st[t].data_ptr<double>()));
     d.kp_ids = model_keypoints(*d.model);
     d.acc_ids = hand_keypoints(*d.model, options.accel_vertices);
+    apply_directions(directions, h, &d);
   }
-  assign_holds(models, distance, data[0].states, start, held, options, &data);
+  assign_holds(models, distance, data[0].states, start, held, options, directions, &data);
   RefineReport local;
-  parallel_for(2, resolve_threads(options.threads), [&](std::size_t h) { refine_hand(&data[h], distance, options, &local.hands[h]); });
+  parallel_for(2, resolve_threads(options.threads),
+               [&](std::size_t h) { refine_hand(&data[h], distance, options, &local.hands[h], directions.w_pin); });
 
   HandMotion motion = hand_motion_from_states({data[0].x, data[1].x}, {data[0].beta, data[1].beta}, N);
   motion.vertices = pose_hand_vertices(models, motion);

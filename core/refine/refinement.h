@@ -34,8 +34,11 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include <ATen/core/Tensor.h>
 
@@ -72,10 +75,39 @@ struct RefineOptions {
   void validate() const;       // throws bimart::Error naming the option
 };
 
+// What an animator fixed (core/directing/, docs/directing.md), as the refinement keeps it:
+//   pins       per hand, frames whose wrist joint (and orientation, finger pose) is held
+//              by w_pin · (||wrist − pin||² + ||log(R_pin^T R)||² + ||θ − θ_pin||²);
+//   clearance  per hand and frame, metres the hand keeps off the object there: its
+//              penetration planes move out by it (so the penetration term and its growing
+//              weight keep every vertex that far out) and its keypoints are not projected
+//              onto the surface;
+//   kept       frames whose starting state is kept as it is (not optimised): the frames
+//              outside a regenerated stretch, which the others then join smoothly;
+//   may_hold, may_hold_top  [N, 2] bool: the hands the hold term may pull onto the object
+//              (its top part) in each frame; undefined: both.
+struct RefineDirections {
+  struct Pin {
+    std::int64_t frame = 0;
+    Eigen::Vector3d wrist = Eigen::Vector3d::Zero();  // world, m
+    std::optional<Eigen::Matrix3d> rotation;          // world: the hand's global orientation
+    std::optional<Eigen::VectorXd> fingers;           // [45] finger pose (rad)
+  };
+  std::array<std::vector<Pin>, 2> pins;
+  std::array<std::vector<double>, 2> clearance;  // N per hand, or empty: none
+  std::vector<bool> kept;                        // N, or empty: none
+  at::Tensor may_hold, may_hold_top;
+  double w_pin = 1e4;  // per pinned frame, not averaged: a pin outweighs the frame's other terms
+  bool empty() const {
+    return pins[0].empty() && pins[1].empty() && clearance[0].empty() && clearance[1].empty() && kept.empty() &&
+           !may_hold.defined() && !may_hold_top.defined();
+  }
+};
+
 // The terms of the cost as defined above, weighted, with exact surface distances.
 struct RefineTerms {
-  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0;
-  double total() const { return proj + pen + acc + fit + hold; }
+  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0;
+  double total() const { return proj + pen + acc + fit + hold + pin; }
 };
 struct RefineHandReport {
   RefineTerms before, after;
@@ -95,12 +127,13 @@ struct RefineReport {
 
 // keypoints X [N, 1200] (canonical frame, DESIGN §4), states [N, 7], start: a fit (world
 // frame), `distance`: the object's (built once per object), `held`: where the hold
-// term applies (core/metrics/held_frames.h; empty: nowhere). Returns the refined motion with
-// posed vertices. Throws bimart::Error for inputs whose shapes disagree.
+// term applies (core/metrics/held_frames.h; empty: nowhere), `directions`: what an animator
+// fixed (above). Returns the refined motion with posed vertices. Throws bimart::Error for
+// inputs whose shapes disagree.
 HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const ObjectDistance& distance, const at::Tensor& states,
                         const at::Tensor& keypoints, const HandMotion& start,
                         const RefineOptions& options = {}, RefineReport* report = nullptr,
-                        const HeldFrames& held = {});
+                        const HeldFrames& held = {}, const RefineDirections& directions = {});
 
 // One line per hand: the terms before → after, depth and keypoint error (for logs).
 std::string format_refine_report(const RefineReport& report);

@@ -7,10 +7,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/geometry/euler.h"
-#include "core/geometry/rotation.h"
 #include "core/trajectory/keyframes.h"
 #include "core/trajectory/validation.h"
+#include "core/trajectory/yaml_reader.h"
 #include "core/util/yaml_keys.h"
 
 namespace bimart {
@@ -19,33 +18,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-struct Reader {
-  std::string file;
-
-  SourceLocation at(const YAML::Node& n) const { return yaml_location(file, n); }
-
-  double number(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) throw Error(at(n), field + " must be a number");
-    double v = 0;
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      throw Error(at(n), field + " must be a number, got '" + n.Scalar() + "'");
-    }
-    if (!std::isfinite(v)) throw Error(at(n), field + " is not a finite number ('" + n.Scalar() + "')");
-    return v;
-  }
-
-  Eigen::Vector3d vec3(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsSequence() || n.size() != 3) throw Error(at(n), field + " must be a list of 3 numbers");
-    return {number(n[0], field), number(n[1], field), number(n[2], field)};
-  }
-
-  std::string text(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) throw Error(at(n), field + " must be a string");
-    return n.Scalar();
-  }
-
+struct Reader : YamlReader {
   std::int64_t seed(const YAML::Node& n) const {
     const double s = number(n, "seed");
     if (s < 0 || s != std::floor(s) || s > 1e15) throw Error(at(n), "seed must be a whole number >= 0");
@@ -71,20 +44,6 @@ struct Reader {
     }
     if (r.path.empty() && r.category.empty()) throw Error(r.where, "object is empty");
     return r;
-  }
-
-  Eigen::Quaterniond rotation(const YAML::Node& n) const {
-    if (!n.IsMap() || n.size() != 1)
-      throw Error(at(n), "rotation must be a map with one key: euler_xyz (or another order, e.g. euler_zyx) or "
-                         "axis_angle, each with 3 numbers in degrees");
-    const auto kv = *n.begin();
-    const std::string key = kv.first.Scalar();
-    const Eigen::Vector3d v = vec3(kv.second, "rotation." + key) * kDeg;
-    if (key == "axis_angle") return Eigen::Quaterniond(axis_angle_to_matrix(v));
-    if (key.rfind("euler_", 0) == 0 && is_euler_order(key.substr(6)))
-      return Eigen::Quaterniond(euler_to_matrix(key.substr(6), v));
-    throw Error(at(kv.first), "unknown rotation '" + key +
-                                  "': use axis_angle, or euler_ with an order such as xyz, zyx, zxz (docs/trajectories.md)");
   }
 
   Keyframe key(const YAML::Node& n) const {
@@ -121,8 +80,8 @@ Trajectory read_yaml_trajectory(const std::string& path, double fps) {
   }
   check_duplicate_keys(source, path);
   if (!root.IsMap()) throw Error(path + ": expected a map with `frames:` or `keys:` (docs/trajectories.md)");
-  check_known_keys(root, {"name", "description", "fps", "object", "rest", "frames", "keys"}, path, "a trajectory file");
-  const Reader r{path};
+  check_known_keys(root, {"name", "description", "fps", "object", "rest", "frames", "keys", "hands"}, path, "a trajectory file");
+  const Reader r{{path}};
   Trajectory tr;
   tr.file = path;
   if (root["name"]) r.text(root["name"], "name");

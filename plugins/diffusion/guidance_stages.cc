@@ -1,8 +1,11 @@
 // guidance.contact_map (DESIGN §5, core/diffusion/contact_guidance.h) and guidance.none.
 #include <ATen/ATen.h>
 
+#include <memory>
+
 #include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/contact_support.h"
+#include "core/directing/contact_rules.h"
 #include "core/features/contact_map.h"
 #include "core/pipeline/plugin.h"
 #include "stages/guidance.h"
@@ -34,7 +37,10 @@ class ContactMapGuidanceStage : public GuidanceStage {
         .param("hold_place", false,
                "with the placement: where the object moves (the hinge turns) and no hand's keypoints come within "
                "place_threshold of it (its top part), the nearest hand is moved onto it (ours; core/diffusion/contact_support.h)")
-        .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample");
+        .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one target per sample")
+        .optional_input<HandConstraints>("hand_constraints",
+                                         "hold and hold_place leave a hand where it must not touch (docs/directing.md), "
+                                         "and the targets keep to the contact constraints");
   }
   explicit ContactMapGuidanceStage(const Params& p)
       : scale_(p.number("scale")), place_steps_(static_cast<int>(p.integer("place_steps"))),
@@ -59,11 +65,15 @@ class ContactMapGuidanceStage : public GuidanceStage {
                                                        : io.in<at::Tensor>("contact_maps").unsqueeze(0);
     const auto [held, turning] = held_frames(object, states);
     const at::Tensor top = hits < static_cast<std::int64_t>(object.top.num_vertices());
-    if (hold_) target = diffusion::hold_contacts(target, held, turning, top, place_.threshold);
+    std::unique_ptr<ContactRules> rules;
+    if (io.has("hand_constraints")) rules = std::make_unique<ContactRules>(io.in<HandConstraints>("hand_constraints"), object, hits);
+    const at::Tensor may_hold = rules ? rules->may_hold() : at::Tensor(), may_top = rules ? rules->may_hold_top() : at::Tensor();
+    if (hold_) target = diffusion::hold_contacts(target, held, turning, top, place_.threshold, may_hold, may_top);
+    if (rules) target = rules->impose(target, 0, -1, 0);
     auto g = std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_);
     g->set_placement(place_steps_, place_);
     g->set_release(release_steps_);
-    if (hold_place_) g->set_support(held, turning, top, place_.threshold);
+    if (hold_place_) g->set_support(held, turning, top, place_.threshold, may_hold, may_top);
     io.out("guidance", std::shared_ptr<const Guidance>(std::move(g)));
   }
 

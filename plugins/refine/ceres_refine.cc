@@ -2,6 +2,13 @@
 // of keypoints plus direction vectors onto the surface, penetration, acceleration, by
 // Ceres with CGAL surface queries (core/refine/refinement.h). Starts from the previous
 // refiner's hand_params (refine.mano_fit); without one it fits first, with defaults.
+#include <ATen/ATen.h>
+#include <fmt/format.h>
+
+#include <optional>
+
+#include "core/directing/refine_directions.h"
+#include "core/io/sequence.h"
 #include "core/features/hand_features.h"
 #include "core/metrics/held_frames.h"
 #include "core/object/object_distance.h"
@@ -38,7 +45,12 @@ class CeresRefineStage : public Refiner {
             .param("threads", d.threads, "0: all cores (one hand per thread)")
             .param("w_hold", d.w_hold,
                    "where the object moves (the hinge turns) and no hand touches it (its top part), the nearer hand "
-                   "is pulled onto it (ours; 0 = off, the paper's)");
+                   "is pulled onto it (ours; 0 = off, the paper's)")
+            .param("w_pin", RefineDirections{}.w_pin,
+                   "pinned wrists, orientations and poses (docs/directing.md): weight per pinned frame")
+            .optional_input<HandConstraints>("hand_constraints",
+                                             "pinned hands are held, hands kept off keep their clearance, the hold term "
+                                             "leaves them (docs/directing.md)");
     refine_plugin::declare_hand_params(s);
     return s;
   }
@@ -59,6 +71,8 @@ class CeresRefineStage : public Refiner {
     o_.threads = static_cast<int>(p.integer("threads"));
     o_.w_hold = p.number("w_hold");
     o_.validate();
+    w_pin_ = p.number("w_pin");
+    if (!(w_pin_ >= 0)) throw Error("'w_pin' must be >= 0");
   }
 
   void run(StageIO& io) override {
@@ -67,6 +81,18 @@ class CeresRefineStage : public Refiner {
     const ObjectDistance distance(object);  // built once, shared by the samples
     const HeldFrames held = o_.w_hold > 0 ? held_frames(object, states) : HeldFrames{};
     const auto models = hands_->pointers();
+    RefineDirections directions;
+    if (io.has("hand_constraints")) directions = refine_directions(io.in<HandConstraints>("hand_constraints"), models, states);
+    directions.w_pin = w_pin_;
+    // A redrawn sample: its frames outside the stretch, and its shape, are kept as they were.
+    std::optional<Sequence> kept;
+    if (io.has("hand_constraints") && io.in<HandConstraints>("hand_constraints").keep) {
+      const KeptSample& k = *io.in<HandConstraints>("hand_constraints").keep;
+      kept = read_sequence(k.sample);
+      if (kept->num_frames() != states.size(0))
+        throw Error(fmt::format("refine.ceres: {} has {} frames, the run {}", k.sample, kept->num_frames(), states.size(0)));
+      for (double w : k.weights(states.size(0))) directions.kept.push_back(w == 1.0);
+    }
     refine_plugin::refine_samples(io, o_.threads, [&](std::size_t k, const at::Tensor& X, const HandMotion* given, int threads) {
       HandMotion start;
       if (given) {
@@ -77,10 +103,11 @@ class CeresRefineStage : public Refiner {
         fit.threads = threads;
         start = fit_mano(models, hand_features_to_world(X, states).positions, fit);
       }
+      if (kept) start = with_kept_frames(start, kept->hands, directions.kept);
       RefineOptions o = o_;
       o.threads = threads;
       RefineReport report;
-      HandMotion motion = refine_hands(models, distance, states, X, start, o, &report, held);
+      HandMotion motion = refine_hands(models, distance, states, X, start, o, &report, held, directions);
       log::info("refine.ceres: {} frames in {:.2f} s (sample {})\n{}", X.size(0), report.seconds, k,
                 format_refine_report(report));
       return motion;
@@ -88,8 +115,27 @@ class CeresRefineStage : public Refiner {
   }
 
  private:
+  // `start` with the kept frames and the shape of `sample` (vertices dropped: they change).
+  static HandMotion with_kept_frames(const HandMotion& start, const HandMotion& sample, const std::vector<bool>& kept) {
+    HandMotion m;
+    std::vector<std::int64_t> rows;
+    for (std::size_t f = 0; f < kept.size(); ++f)
+      if (kept[f]) rows.push_back(static_cast<std::int64_t>(f));
+    const at::Tensor idx = at::tensor(rows, at::kLong);
+    for (int h = 0; h < 2; ++h) {
+      const HandParams &a = start.hands[static_cast<std::size_t>(h)], &b = sample.hands[static_cast<std::size_t>(h)];
+      HandParams& o = m.hands[static_cast<std::size_t>(h)];
+      o.rot = a.rot.clone().index_copy_(0, idx, b.rot.to(at::kFloat).index_select(0, idx));
+      o.pose = a.pose.clone().index_copy_(0, idx, b.pose.to(at::kFloat).index_select(0, idx));
+      o.trans = a.trans.clone().index_copy_(0, idx, b.trans.to(at::kFloat).index_select(0, idx));
+      o.shape = b.shape.to(at::kFloat).clone();
+    }
+    return m;
+  }
+
   std::shared_ptr<const refine_plugin::HandPair> hands_;
   RefineOptions o_;
+  double w_pin_ = 0;
 };
 
 }  // namespace

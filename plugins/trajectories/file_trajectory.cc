@@ -2,6 +2,13 @@
 // sequence .npz, or YAML keyframes (core/trajectory/, docs/trajectories.md). Everything is
 // read and checked against the object when the stage is created, before any stage runs.
 #include <ATen/ATen.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <filesystem>
+
+#include "core/directing/hand_constraints.h"
+#include "core/util/log.h"
 
 #include "core/pipeline/plugin.h"
 #include "core/trajectory/trajectory.h"
@@ -18,6 +25,9 @@ class FileTrajectory : public TrajectorySource {
     return StageSpec::of<TrajectorySource>(
                "file", "a trajectory file: per-frame .csv, .yaml or .npz, or YAML keyframes (docs/trajectories.md)")
         .output<std::string>("object_path", "the object's folder or YAML, absolute")
+        .output<HandConstraints>("hand_constraints",
+                                 "what the file's `hands:` block and the `hands` parameter ask of the hands "
+                                 "(docs/directing.md); empty when nothing")
         .param("path", "", "trajectory file: .csv, .yaml/.yml (frames: or keys:), .npz sequence")
         .param("object", "",
                "object folder or object.yaml (bimart object make / import) or ARCTIC template folder, relative to "
@@ -28,7 +38,17 @@ class FileTrajectory : public TrajectorySource {
                "frames per second: keyframes are sampled at it, a per-frame file plays at it (0: the file's, else 30)")
         .param("object_dir", "",
                "folder a procedural object is written to, for exporters (default: ~/.cache/bimart/objects/"
-               "CATEGORY_SEED)");
+               "CATEGORY_SEED)")
+        .param("hands", "",
+               "more hand constraints (docs/directing.md): a YAML file with a `hands:` block, or the block's value "
+               "inline, e.g. '{right: [{frames: [0, 40], part: top}]}'; added to the trajectory file's own")
+        .param("redraw", std::vector<std::int64_t>{},
+               "[first, last] (last -1: the last frame): the trajectory file is an earlier sample (.npz); redraw these frames and keep the "
+               "others exactly (bimart edit, docs/directing.md); empty: off")
+        .param("keep_contacts", false,
+               "with an earlier sample as the trajectory: keep its contact maps everywhere, redraw the motion "
+               "(over `redraw`, else every frame)")
+        .param("redraw_blend", 8, "frames over which a redrawn stretch fades in from the kept frames at each join");
   }
 
   explicit FileTrajectory(const Params& p) {
@@ -42,6 +62,14 @@ class FileTrajectory : public TrajectorySource {
     trajectory_ = read_trajectory(path, p.number("fps"));
     object_ = resolve_trajectory_object(chosen, trajectory_.object, path, p.string("object_dir"));
     validate_trajectory(trajectory_, object_.object);
+    hands_ = read_hand_constraints(path, trajectory_);
+    if (const std::string& more = p.string("hands"); !more.empty()) {
+      const bool inline_text = more.find_first_of("{[:\n") != std::string::npos;
+      merge_hand_constraints(hands_, inline_text ? parse_hand_constraints(more, "parameter hands", "", trajectory_)
+                                                 : read_hand_constraints(more, trajectory_, true));
+    }
+    read_redraw(p, path);
+    if (!hands_.empty()) log::info("trajectory.file: hands directed: {}", hands_.describe());
   }
 
   void run(StageIO& io) override {
@@ -52,11 +80,37 @@ class FileTrajectory : public TrajectorySource {
     io.out("object_states", states);
     io.out("fps", trajectory_.fps);
     io.out("object_path", object_.path);
+    io.out("hand_constraints", hands_);
   }
 
  private:
+  void read_redraw(const Params& p, const std::string& path) {
+    const auto& range = p.integers("redraw");
+    const bool keep_contacts = p.boolean("keep_contacts");
+    if (range.empty() && !keep_contacts) return;
+    if (std::filesystem::path(path).extension() != ".npz")
+      throw Error("redraw and keep_contacts need an earlier sample (.npz) as the trajectory file, got " + path);
+    const std::int64_t n = trajectory_.num_frames();
+    KeptSample k;
+    k.sample = path;
+    k.keep_contacts = keep_contacts;
+    k.blend = static_cast<int>(p.integer("redraw_blend"));
+    if (k.blend < 0) throw Error("redraw_blend must be >= 0 frames");
+    k.redraw = {0, n - 1};
+    if (!range.empty()) {
+      std::vector<std::int64_t> r = range;
+      if (r.size() == 2 && r[1] == -1) r[1] = n - 1;  // -1: the last frame
+      if (r.size() != 2 || r[0] < 0 || r[1] < r[0] || r[1] >= n)
+        throw Error(fmt::format("redraw must be [first, last] with 0 <= first <= last < {} (the sample's frames), got [{}]",
+                                n, fmt::join(range, ", ")));
+      k.redraw = {r[0], r[1]};
+    }
+    hands_.keep = k;
+  }
+
   Trajectory trajectory_;
   TrajectoryObject object_;
+  HandConstraints hands_;
 };
 
 }  // namespace

@@ -1,0 +1,86 @@
+// `bimart edit SAMPLE.npz --frames A:B`: an earlier sample with a stretch redrawn
+// (docs/directing.md). Runs a pipeline (the default one unless --pipeline) on the sample
+// itself as the trajectory, with `trajectory.redraw` set: the frames outside A..B come out
+// exactly as they were, the stretch is sampled anew and joined to them.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <string>
+
+#include "core/cli/command.h"
+#include "core/cli/common_options.h"
+#include "core/cli/pipeline_commands.h"
+#include "core/util/data_path.h"
+#include "core/util/error.h"
+
+namespace bimart::cli {
+namespace {
+
+struct EditArgs {
+  std::string sample, frames, pipeline = "pipelines/bimart.yaml", out;
+  std::vector<std::string> overrides;
+  bool keep_contacts = false;
+  int blend = 8;
+  std::uint64_t seed = 0;
+  bool has_seed = false;
+};
+
+// "40:90" (both included), "40:" (to the end), ":90", or "" (with --keep-contacts: all).
+std::string redraw_value(const std::string& text) {
+  const auto colon = text.find(':');
+  if (colon == std::string::npos) throw Error("--frames: write FIRST:LAST (both included), e.g. 40:90; got '" + text + "'");
+  const auto number = [&](const std::string& s, long fallback) {
+    if (s.empty()) return fallback;  // the stage checks the range against the sample
+    std::size_t used = 0;
+    long v = -1;
+    try {
+      v = std::stol(s, &used);
+    } catch (const std::exception&) {
+    }
+    if (used != s.size() || v < 0) throw Error("--frames: '" + s + "' is not a frame number (FIRST:LAST, e.g. 40:90)");
+    return v;
+  };
+  const long a = number(text.substr(0, colon), 0), b = number(text.substr(colon + 1), -1);  // -1: the last
+  return fmt::format("[{}, {}]", a, b);
+}
+
+int edit(const EditArgs& e) {
+  if (e.frames.empty() && !e.keep_contacts) throw Error("give --frames FIRST:LAST (or --keep-contacts to redraw all motion)");
+  PipelineArgs pa;
+  pa.pipeline = find_data_file(e.pipeline);
+  pa.overrides = {"trajectory.path=" + e.sample, fmt::format("trajectory.redraw_blend={}", e.blend)};
+  if (!e.frames.empty()) {
+    pa.overrides.push_back("trajectory.redraw=" + redraw_value(e.frames));
+  }
+  if (e.keep_contacts) pa.overrides.push_back("trajectory.keep_contacts=true");
+  pa.overrides.insert(pa.overrides.end(), e.overrides.begin(), e.overrides.end());
+  const std::filesystem::path s(e.sample);
+  pa.out = !e.out.empty() ? e.out : (s.parent_path() / (s.stem().string() + "_edit")).string();
+  pa.samples = 1;
+  pa.seed = e.seed;
+  pa.has_seed = e.has_seed;
+  return run(pa);
+}
+
+}  // namespace
+
+void add_edit_commands(CLI::App& app, Commands& out) {
+  static EditArgs e;
+  CLI::App* cmd = app.add_subcommand("edit", "redraw a stretch of an earlier sample, keeping every other frame (docs/directing.md)");
+  cmd->add_option("sample", e.sample, "the sample's sequence file (sample_K.npz of bimart run)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--frames", e.frames, "FIRST:LAST, both included: the frames drawn anew (FIRST: = to the end)");
+  cmd->add_flag("--keep-contacts", e.keep_contacts, "keep the sample's contact maps everywhere; draw only new motion");
+  cmd->add_option("--blend", e.blend, "frames over which the stretch fades in from the kept frames at each join")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--pipeline", e.pipeline, "the pipeline to run (its trajectory stage must be trajectory.file)");
+  cmd->add_option("--out", e.out, "output folder (default: next to the sample, SAMPLE_edit)");
+  cmd->add_option("--set", e.overrides, "override a parameter: stage.param=value (repeatable)");
+  add_seed_option(cmd, e.seed, "seed of the redrawn stretch (default: the pipeline's)")->each([](const std::string&) {
+    e.has_seed = true;
+  });
+  out.push_back({cmd, [] { return edit(e); }});
+}
+
+}  // namespace bimart::cli

@@ -1,0 +1,190 @@
+#include "core/directing/hand_pins.h"
+
+#include <ATen/ATen.h>
+#include <fmt/format.h>
+
+#include <Eigen/SVD>
+#include <cmath>
+
+#include "core/features/hand_features.h"
+#include "core/hand/keypoints.h"
+#include "core/hand/lbs.h"
+#include "core/io/sequence.h"
+#include "core/object/object_state.h"
+
+namespace bimart {
+namespace {
+
+Eigen::Isometry3d pose_at(const at::Tensor& states, std::int64_t f) {
+  return canonical_to_world(ObjectState::from_row(states[f].contiguous().data_ptr<double>()));
+}
+
+at::Tensor rows_of(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& m, const std::vector<int>& ids) {
+  at::Tensor out = at::empty({static_cast<std::int64_t>(ids.size()), 3}, at::kDouble);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    for (int c = 0; c < 3; ++c) out[static_cast<std::int64_t>(i)][c] = m(ids[i], c);
+  return out;
+}
+
+// Keypoints [J, 3] of the hand `side` of `source` at `frame`, in the object's canonical
+// frame there (float32).
+at::Tensor source_keypoints(const HandModel& model, const std::string& source, std::int64_t frame, int side) {
+  const Sequence seq = read_sequence(source);
+  const HandParams& p = seq.hands.hands[static_cast<std::size_t>(side)];
+  const auto vec = [&](const at::Tensor& t) {
+    const at::Tensor d = t.to(at::kDouble).contiguous();
+    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel()));
+  };
+  const Eigen::VectorXd rot = vec(p.rot[frame]), pose = vec(p.pose[frame]), trans = vec(p.trans[frame]),
+                        shape = vec(p.shape);
+  const LbsResult<double> r = lbs<double>(model, Eigen::Vector3d(rot), pose, Eigen::Vector3d(trans), shape);
+  const Eigen::Isometry3d to_canonical = pose_at(seq.object_states.to(at::kDouble).contiguous(), frame).inverse();
+  at::Tensor k = rows_of(r.vertices, model_keypoints(model));
+  for (std::int64_t i = 0; i < k.size(0); ++i) {
+    const Eigen::Vector3d v(k[i][0].item<double>(), k[i][1].item<double>(), k[i][2].item<double>());
+    const Eigen::Vector3d c = to_canonical * v;
+    for (int a = 0; a < 3; ++a) k[i][a] = c[a];
+  }
+  return k.to(at::kFloat);
+}
+
+}  // namespace
+
+HandPins::HandPins(const HandConstraints& constraints, const std::array<const HandModel*, 2>& hands,
+                   const at::Tensor& states, const at::Tensor& object_points, double sigma)
+    : states_(states.to(at::kDouble).contiguous()), points_(object_points.to(at::kFloat).contiguous()), sigma_(sigma) {
+  const std::int64_t N = states_.size(0);
+  if (!(sigma >= 0)) throw Error("hand pins: sigma must be >= 0 (frames)");
+  for (int h = 0; h < 2; ++h) {
+    const HandModel& m = *hands[static_cast<std::size_t>(h)];
+    const std::vector<int> ids = model_keypoints(m), part = hand_parts(m);
+    std::vector<int> palm_rows, palm_ids;
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (part[static_cast<std::size_t>(ids[i])] == 0) palm_rows.push_back(static_cast<int>(i)), palm_ids.push_back(ids[i]);
+    if (palm_rows.size() < 3) throw Error("hand pins: the hand model has fewer than 3 keypoints on the palm");
+    const Eigen::VectorXd zero_pose = Eigen::VectorXd::Zero(HandModel::kPoseDim), zero_shape = Eigen::VectorXd::Zero(HandModel::kNumBetas);
+    const LbsResult<double> rest = lbs<double>(m, Eigen::Vector3d::Zero(), zero_pose, Eigen::Vector3d::Zero(), zero_shape);
+    Palm& p = palms_[static_cast<std::size_t>(h)];
+    p.rest = rows_of(rest.vertices, palm_ids);
+    p.wrist = rest.joints.row(0).transpose();
+    p.index = at::tensor(std::vector<std::int64_t>(palm_rows.begin(), palm_rows.end()), at::kLong);
+  }
+  for (const HandPin& pin : constraints.pins) {
+    if (pin.frames.last >= N)
+      throw Error(pin.where, fmt::format("frames up to {}, but the trajectory has {} frames", pin.frames.last, N));
+    at::Tensor pose;
+    if (pin.whole_pose())
+      pose = source_keypoints(*hands[static_cast<std::size_t>(pin.hand)], pin.source, pin.source_frame, pin.hand);
+    for (std::int64_t f = pin.frames.first; f <= pin.frames.last; ++f) {
+      const Eigen::Isometry3d to_canonical = pose_at(states_, f).inverse();
+      Target t;
+      t.hand = pin.hand;
+      t.frame = f;
+      t.keypoints = pose;
+      if (pin.wrist) t.wrist = to_canonical * *pin.wrist;
+      if (pin.rotation) t.turn = true, t.rotation = to_canonical.linear() * pin.rotation->toRotationMatrix();
+      targets_.push_back(t);
+    }
+  }
+  for (const ContactConstraint& c : constraints.contacts)
+    if (c.part == ContactPart::None) {
+      if (c.frames.last >= N)
+        throw Error(c.where, fmt::format("frames up to {}, but the trajectory has {} frames", c.frames.last, N));
+      away_.push_back({c.hand, c.frames.first, c.frames.last, c.clearance});
+    }
+}
+
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> HandPins::fit_palm(const at::Tensor& keypoints, int hand) const {
+  const Palm& palm = palms_[static_cast<std::size_t>(hand)];
+  const at::Tensor P = keypoints.to(at::kDouble).index_select(0, palm.index).contiguous();  // current
+  const at::Tensor Q = palm.rest;                                                            // rest
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  const Eigen::Map<const Rows> p(P.data_ptr<double>(), P.size(0), 3), q(Q.data_ptr<double>(), Q.size(0), 3);
+  const Eigen::RowVector3d pc = p.colwise().mean(), qc = q.colwise().mean();
+  // Kabsch: R minimising |R (q - qc) - (p - pc)|, a proper rotation.
+  const Eigen::Matrix3d cov = (q.rowwise() - qc).transpose() * (p.rowwise() - pc);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
+  fix(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  const Eigen::Matrix3d R = svd.matrixV() * fix * svd.matrixU().transpose();
+  return {R, R * (palm.wrist - qc.transpose()) + pc.transpose()};
+}
+
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> HandPins::wrist_of(const at::Tensor& keypoints, int hand,
+                                                               std::int64_t frame) const {
+  const auto [R, w] = fit_palm(keypoints, hand);
+  const Eigen::Isometry3d to_world = pose_at(states_, frame);
+  return {to_world * w, to_world.linear() * R};
+}
+
+at::Tensor HandPins::impose(const at::Tensor& x0, std::int64_t first, int /*step*/, int /*num_steps*/) const {
+  if (empty()) return x0;
+  const std::int64_t B = x0.size(0), T = x0.size(1), J = kHandKeypoints;
+  const at::Tensor H = x0.slice(-1, 0, 600).to(at::kFloat).reshape({B, T, 2, J, 3});
+  // Each pinned frame's change [B, J, 3], exact there and spread around it.
+  at::Tensor spread = at::zeros({B, T, 2, J, 3}, at::kFloat), weight = at::zeros({T, 2}, at::kFloat);
+  at::Tensor exact = at::zeros({B, T, 2, J, 3}, at::kFloat), pinned = at::zeros({T, 2}, at::kBool);
+  const std::int64_t reach = static_cast<std::int64_t>(std::ceil(3 * sigma_));
+  for (const Target& tg : targets_) {
+    const std::int64_t t = tg.frame - first;
+    if (t < -reach || t >= T + reach) continue;
+    // The pin's change, measured on the frame itself when it is in the window, else on the
+    // window's nearest frame (its neighbours still run into it).
+    const std::int64_t at_t = std::clamp<std::int64_t>(t, 0, T - 1);
+    at::Tensor delta = at::empty({B, J, 3}, at::kFloat);
+    for (std::int64_t b = 0; b < B; ++b) {
+      const at::Tensor k = H[b][at_t][tg.hand];
+      at::Tensor target;
+      if (tg.keypoints.defined()) {
+        target = tg.keypoints;
+      } else {
+        const auto [R, w] = fit_palm(k, tg.hand);
+        const Eigen::Matrix3d turn = tg.turn ? Eigen::Matrix3d(tg.rotation * R.transpose()) : Eigen::Matrix3d::Identity();
+        at::Tensor Rt = at::empty({3, 3}, at::kDouble), wt = at::empty({3}, at::kDouble), pt = at::empty({3}, at::kDouble);
+        for (int r = 0; r < 3; ++r) {
+          wt[r] = w[r], pt[r] = tg.wrist[r];
+          for (int c = 0; c < 3; ++c) Rt[r][c] = turn(c, r);
+        }
+        target = (at::matmul(k.to(at::kDouble) - wt, Rt) + pt).to(at::kFloat);
+      }
+      delta[b] = target - k;
+    }
+    if (t >= 0 && t < T) {
+      exact.select(1, t).select(1, tg.hand).copy_(delta);
+      pinned[t][tg.hand] = true;
+    }
+    if (sigma_ <= 0) continue;
+    for (std::int64_t s = std::max<std::int64_t>(0, t - reach); s < std::min(T, t + reach + 1); ++s) {
+      const double g = std::exp(-0.5 * std::pow(static_cast<double>(s - t) / sigma_, 2));
+      spread.select(1, s).select(1, tg.hand) += static_cast<float>(g) * delta;
+      weight[s][tg.hand] += static_cast<float>(g);
+    }
+  }
+  at::Tensor change = spread / weight.clamp_min(1.0).view({1, T, 2, 1, 1});
+  change = at::where(pinned.view({1, T, 2, 1, 1}), exact, change);
+  at::Tensor Hn = H + change;
+  // Hands kept off the object: moved away from their nearest object point, a few rounds.
+  for (const Away& a : away_) {
+    const std::int64_t s0 = std::max(a.first - first, std::int64_t{0}), s1 = std::min(a.last - first + 1, T);
+    for (std::int64_t s = s0; s < s1; ++s) {
+      const at::Tensor P = points_[first + s];  // [1024, 3]
+      for (std::int64_t b = 0; b < B; ++b) {
+        at::Tensor k = Hn[b][s][a.hand];  // view
+        for (int round = 0; round < 4; ++round) {
+          const at::Tensor d = at::cdist(k.unsqueeze(0), P.unsqueeze(0)).squeeze(0);  // [J, 1024]
+          const auto [dmin, pi] = d.view({-1}).min(0);
+          const float gap = dmin.item<float>();
+          if (gap >= a.clearance) break;
+          const std::int64_t i = pi.item<std::int64_t>();
+          at::Tensor dir = k[i / P.size(0)] - P[i % P.size(0)];
+          dir = gap > 1e-6f ? dir / gap : at::tensor({0.f, 1.f, 0.f});
+          k += (static_cast<float>(a.clearance) - gap + 1e-4f) * dir;
+        }
+      }
+    }
+  }
+  const at::Tensor moved = (Hn - H).reshape({B, T, 600});
+  return at::cat({Hn.reshape({B, T, 600}), x0.slice(-1, 600, 1200).to(at::kFloat) - moved}, -1).to(x0.scalar_type());
+}
+
+}  // namespace bimart

@@ -1,0 +1,75 @@
+// Pinned hands and hands kept off the object (core/directing/hand_constraints.h) imposed on
+// the motion model's prediction X = [H | D] (canonical object frame) at every denoising
+// step — in-painting in the keypoint space:
+//   wrist pin     the hand's keypoints moved rigidly so its wrist is at the pin (and turned
+//                 to the pinned orientation when one is given). The wrist and the hand's
+//                 orientation are read from its palm keypoints by a rigid fit (Kabsch) to
+//                 the hand model's flat rest palm, whose wrist joint is known;
+//   pose pin      the hand's keypoints replaced by those of the sample's hand at its frame,
+//                 relative to the object as they were there;
+//   part: none    a hand whose keypoints come within `clearance` of the object points is
+//                 moved straight away from the nearest one until they do not.
+// A pinned frame's change of every keypoint also moves the frames around it, weighted by
+// a Gaussian of `sigma` frames (the pinned frames exactly), so the motion runs smoothly into
+// the pin. D moves opposite to H, so H + D (the object point each keypoint refers to) stays.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
+
+#include "core/directing/hand_constraints.h"
+#include "core/hand/hand_model.h"
+#include "stages/sample_constraint.h"
+
+namespace bimart {
+
+class HandPins : public SampleConstraint {
+ public:
+  // states [N, 7] (object states of the run), object_points [N, 1024, 3] (canonical frame,
+  // articulated: basis_hit_points) for the hands kept off. sigma: frames.
+  HandPins(const HandConstraints& constraints, const std::array<const HandModel*, 2>& hands, const at::Tensor& states,
+           const at::Tensor& object_points, double sigma = 4.0);
+
+  bool empty() const { return targets_.empty() && away_.empty(); }
+  at::Tensor impose(const at::Tensor& x0, std::int64_t first_frame, int step, int num_steps) const override;
+
+  // The wrist (world frame) that the keypoints H [J, 3] of `hand` (canonical frame, frame
+  // `frame` of the run) imply, and the hand's orientation (world): for tests and checks.
+  std::pair<Eigen::Vector3d, Eigen::Matrix3d> wrist_of(const at::Tensor& keypoints, int hand, std::int64_t frame) const;
+
+  struct Target {
+    int hand = 0;
+    std::int64_t frame = 0;
+    Eigen::Vector3d wrist;     // canonical frame
+    bool turn = false;         // rotation pinned
+    Eigen::Matrix3d rotation;  // canonical frame
+    at::Tensor keypoints;      // [J, 3] float32 canonical (pose pin), else undefined
+  };
+
+ private:
+  struct Palm {
+    at::Tensor rest;        // [P, 3] float64: the palm keypoints of the flat rest hand
+    Eigen::Vector3d wrist;  // its wrist joint
+    at::Tensor index;       // [P] int64: which of the J keypoints are on the palm
+  };
+  // Rotation R and wrist w of a hand from its keypoints [J, 3] (canonical frame).
+  std::pair<Eigen::Matrix3d, Eigen::Vector3d> fit_palm(const at::Tensor& keypoints, int hand) const;
+
+  std::array<Palm, 2> palms_;
+  std::vector<Target> targets_;
+  struct Away {
+    int hand;
+    std::int64_t first, last;
+    double clearance;
+  };
+  std::vector<Away> away_;
+  at::Tensor states_;  // [N, 7] float64
+  at::Tensor points_;  // [N, 1024, 3] float32
+  double sigma_;
+};
+
+}  // namespace bimart
