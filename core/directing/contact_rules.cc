@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <limits>
-#include <tuple>
 
 namespace bimart {
 namespace {
@@ -28,7 +27,6 @@ ContactRules::ContactRules(const HandConstraints& constraints, const Articulated
   floor_ = at::zeros({N, 2, M}, at::kFloat);
   required_ = at::zeros({N, 2, M}, at::kBool);
   touch_ = at::zeros({N, 2}, at::kBool);
-  std::tie(may_hold_, may_hold_top_) = hands_that_may_hold(constraints, N);
   const at::Tensor top = hits < static_cast<std::int64_t>(object.top.num_vertices());  // [N, M]
   at::Tensor rest;
   for (const ContactConstraint& c : constraints.contacts) {

@@ -38,17 +38,12 @@ class ContactRules : public SampleConstraint {
   bool empty() const { return empty_; }
   // C [B, T, 2, 1024] or [B, T, 2048] (metres) for frames [first, first + T): the maps with the rules imposed.
   at::Tensor impose(const at::Tensor& maps, std::int64_t first_frame, int step, int num_steps) const override;
-  // Per frame and hand [N, 2]: may this hand hold the object there (no `none`), and may it
-  // be on the top part (no `none` or `bottom`). For the guidance's hold and support.
-  at::Tensor may_hold() const { return may_hold_; }
-  at::Tensor may_hold_top() const { return may_hold_top_; }
 
  private:
   bool empty_ = true;
   at::Tensor floor_;     // [N, 2, 1024] float: entries at least this
   at::Tensor required_;  // [N, 2, 1024] bool: the hand touches among these (none set: no requirement)
   at::Tensor touch_;     // [N, 2] bool
-  at::Tensor may_hold_, may_hold_top_;  // [N, 2] bool
 };
 
 }  // namespace bimart

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/io/sequence.h"
+#include "core/object/object_state.h"
 #include "core/trajectory/yaml_reader.h"
 #include "core/util/yaml_keys.h"
 
@@ -259,6 +260,23 @@ std::pair<at::Tensor, at::Tensor> hands_that_may_hold(const HandConstraints& con
     if (c.part == ContactPart::None || c.part == ContactPart::Bottom) span(top).fill_(false);
   }
   return {any, top};
+}
+
+Eigen::Isometry3d object_pose_at(const at::Tensor& states, std::int64_t frame) {
+  const at::Tensor row = states[frame].to(at::kDouble).contiguous();
+  return canonical_to_world(ObjectState::from_row(row.data_ptr<double>()));
+}
+
+PinnedPose read_pinned_pose(const HandPin& pin) {
+  const Sequence seq = read_sequence(pin.source);
+  const HandParams& p = seq.hands.hands[static_cast<std::size_t>(pin.hand)];
+  const std::int64_t f = pin.source_frame;
+  const auto vec = [](const at::Tensor& t) {
+    const at::Tensor d = t.to(at::kDouble).contiguous();
+    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel()));
+  };
+  return {Eigen::Vector3d(vec(p.rot[f])), Eigen::Vector3d(vec(p.trans[f])), vec(p.pose[f]), vec(p.shape),
+          object_pose_at(seq.object_states, f)};
 }
 
 void merge_hand_constraints(HandConstraints& base, const HandConstraints& extra) {

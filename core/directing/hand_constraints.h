@@ -114,6 +114,18 @@ HandConstraints parse_hand_constraints(const std::string& text, const std::strin
 // refinement may choose from.
 std::pair<at::Tensor, at::Tensor> hands_that_may_hold(const HandConstraints& constraints, std::int64_t frames);
 
+// A pose pin's source: the hand's MANO parameters at its frame (world frame) and the
+// object's pose there. Throws naming the file when it cannot be read.
+struct PinnedPose {
+  Eigen::Vector3d rot, trans;  // axis-angle, metres
+  Eigen::VectorXd pose, shape;  // [45], [10]
+  Eigen::Isometry3d object;    // canonical -> world at the source frame
+};
+PinnedPose read_pinned_pose(const HandPin& pin);
+
+// The object's pose (canonical -> world) at frame `frame` of states [N, 7].
+Eigen::Isometry3d object_pose_at(const at::Tensor& states, std::int64_t frame);
+
 // Every constraint of `extra` added to `base`, checked again for overlaps.
 void merge_hand_constraints(HandConstraints& base, const HandConstraints& extra);
 

@@ -9,15 +9,9 @@
 #include "core/features/hand_features.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
-#include "core/io/sequence.h"
-#include "core/object/object_state.h"
 
 namespace bimart {
 namespace {
-
-Eigen::Isometry3d pose_at(const at::Tensor& states, std::int64_t f) {
-  return canonical_to_world(ObjectState::from_row(states[f].contiguous().data_ptr<double>()));
-}
 
 at::Tensor rows_of(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& m, const std::vector<int>& ids) {
   at::Tensor out = at::empty({static_cast<std::int64_t>(ids.size()), 3}, at::kDouble);
@@ -26,26 +20,19 @@ at::Tensor rows_of(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajo
   return out;
 }
 
-// Keypoints [J, 3] of the hand `side` of `source` at `frame`, in the object's canonical
+// Keypoints [J, 3] of a pose pin's hand at its source frame, in the object's canonical
 // frame there (float32).
-at::Tensor source_keypoints(const HandModel& model, const std::string& source, std::int64_t frame, int side) {
-  const Sequence seq = read_sequence(source);
-  const HandParams& p = seq.hands.hands[static_cast<std::size_t>(side)];
-  const auto vec = [&](const at::Tensor& t) {
-    const at::Tensor d = t.to(at::kDouble).contiguous();
-    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel()));
-  };
-  const Eigen::VectorXd rot = vec(p.rot[frame]), pose = vec(p.pose[frame]), trans = vec(p.trans[frame]),
-                        shape = vec(p.shape);
-  const LbsResult<double> r = lbs<double>(model, Eigen::Vector3d(rot), pose, Eigen::Vector3d(trans), shape);
-  const Eigen::Isometry3d to_canonical = pose_at(seq.object_states.to(at::kDouble).contiguous(), frame).inverse();
-  at::Tensor k = rows_of(r.vertices, model_keypoints(model));
-  for (std::int64_t i = 0; i < k.size(0); ++i) {
-    const Eigen::Vector3d v(k[i][0].item<double>(), k[i][1].item<double>(), k[i][2].item<double>());
-    const Eigen::Vector3d c = to_canonical * v;
-    for (int a = 0; a < 3; ++a) k[i][a] = c[a];
+at::Tensor source_keypoints(const HandModel& model, const HandPin& pin) {
+  const PinnedPose src = read_pinned_pose(pin);
+  const LbsResult<double> r = lbs<double>(model, src.rot, src.pose, src.trans, src.shape);
+  const Eigen::Isometry3d to_canonical = src.object.inverse();
+  const std::vector<int> ids = model_keypoints(model);
+  at::Tensor k = at::empty({static_cast<std::int64_t>(ids.size()), 3}, at::kFloat);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const Eigen::Vector3d c = to_canonical * Eigen::Vector3d(r.vertices.row(ids[i]).transpose());
+    for (int a = 0; a < 3; ++a) k[static_cast<std::int64_t>(i)][a] = c[a];
   }
-  return k.to(at::kFloat);
+  return k;
 }
 
 }  // namespace
@@ -74,9 +61,9 @@ HandPins::HandPins(const HandConstraints& constraints, const std::array<const Ha
       throw Error(pin.where, fmt::format("frames up to {}, but the trajectory has {} frames", pin.frames.last, N));
     at::Tensor pose;
     if (pin.whole_pose())
-      pose = source_keypoints(*hands[static_cast<std::size_t>(pin.hand)], pin.source, pin.source_frame, pin.hand);
+      pose = source_keypoints(*hands[static_cast<std::size_t>(pin.hand)], pin);
     for (std::int64_t f = pin.frames.first; f <= pin.frames.last; ++f) {
-      const Eigen::Isometry3d to_canonical = pose_at(states_, f).inverse();
+      const Eigen::Isometry3d to_canonical = object_pose_at(states_, f).inverse();
       Target t;
       t.hand = pin.hand;
       t.frame = f;
@@ -113,7 +100,7 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> HandPins::fit_palm(const at::Tensor&
 std::pair<Eigen::Vector3d, Eigen::Matrix3d> HandPins::wrist_of(const at::Tensor& keypoints, int hand,
                                                                std::int64_t frame) const {
   const auto [R, w] = fit_palm(keypoints, hand);
-  const Eigen::Isometry3d to_world = pose_at(states_, frame);
+  const Eigen::Isometry3d to_world = object_pose_at(states_, frame);
   return {to_world * w, to_world.linear() * R};
 }
 

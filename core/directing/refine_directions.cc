@@ -3,25 +3,12 @@
 #include <ATen/ATen.h>
 #include <fmt/format.h>
 
-#include <map>
 
 #include "core/geometry/rotation.h"
 #include "core/hand/lbs.h"
-#include "core/io/sequence.h"
-#include "core/object/object_state.h"
 
 namespace bimart {
 namespace {
-
-Eigen::Isometry3d pose_at(const at::Tensor& states, std::int64_t f) {
-  const at::Tensor row = states[f].to(at::kDouble).contiguous();
-  return canonical_to_world(ObjectState::from_row(row.data_ptr<double>()));
-}
-
-Eigen::VectorXd vec(const at::Tensor& t) {
-  const at::Tensor d = t.to(at::kDouble).contiguous();
-  return Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel());
-}
 
 // The hand of a pose pin at its source frame: wrist (world), orientation, fingers; and the
 // object's pose there.
@@ -33,16 +20,12 @@ struct SourceHand {
 };
 
 SourceHand source_hand(const HandModel& model, const HandPin& pin) {
-  const Sequence seq = read_sequence(pin.source);
-  const HandParams& p = seq.hands.hands[static_cast<std::size_t>(pin.hand)];
-  const std::int64_t f = pin.source_frame;
-  const Eigen::VectorXd rot = vec(p.rot[f]), trans = vec(p.trans[f]), beta = vec(p.shape);
+  const PinnedPose src = read_pinned_pose(pin);
   const Eigen::Vector3d j0 = lbs<double>(model, Eigen::Vector3d::Zero(), Eigen::VectorXd::Zero(HandModel::kPoseDim),
-                                         Eigen::Vector3d::Zero(), beta)
+                                         Eigen::Vector3d::Zero(), src.shape)
                                  .joints.row(0)
                                  .transpose();
-  return {Eigen::Vector3d(trans) + j0, axis_angle_to_matrix(Eigen::Vector3d(rot)), vec(p.pose[f]),
-          pose_at(seq.object_states, f)};
+  return {src.trans + j0, axis_angle_to_matrix(src.rot), src.pose, src.object};
 }
 
 }  // namespace
@@ -67,7 +50,7 @@ RefineDirections refine_directions(const HandConstraints& constraints, const std
       RefineDirections::Pin p;
       p.frame = f;
       if (src) {
-        const Eigen::Isometry3d carry = pose_at(states, f) * src->object.inverse();
+        const Eigen::Isometry3d carry = object_pose_at(states, f) * src->object.inverse();
         p.wrist = carry * src->wrist;
         p.rotation = Eigen::Matrix3d(carry.linear() * src->rotation);
         p.fingers = src->fingers;

@@ -283,19 +283,21 @@ class HoldCost : public ceres::CostFunction {
   std::vector<Block> blocks_;
 };
 
-// A pinned wrist: r = s (trans + j0 − wrist) on the translation block.
-class WristPinCost : public ceres::SizedCostFunction<3, 3> {
+// N pinned values of one parameter block: r = s (x − target). The wrist's translation
+// block (target: the pin minus j0) and each finger's block (its three joints).
+template <int N>
+class ValuePinCost : public ceres::SizedCostFunction<N, N> {
  public:
-  WristPinCost(Eigen::Vector3d target, double s) : target_(std::move(target)), s_(s) {}
+  ValuePinCost(const double* target, double s) : s_(s) { std::copy(target, target + N, target_); }
   bool Evaluate(double const* const* x, double* r, double** J) const override {
-    for (int c = 0; c < 3; ++c) r[c] = s_ * (x[0][c] - target_[c]);
+    for (int c = 0; c < N; ++c) r[c] = s_ * (x[0][c] - target_[c]);
     if (J && J[0])
-      for (int i = 0; i < 9; ++i) J[0][i] = i % 4 == 0 ? s_ : 0.0;
+      for (int i = 0; i < N * N; ++i) J[0][i] = i % (N + 1) == 0 ? s_ : 0.0;
     return true;
   }
 
  private:
-  Eigen::Vector3d target_;  // the pin minus j0: what trans must be
+  double target_[N];
   double s_;
 };
 
@@ -316,22 +318,6 @@ struct RotationPin {
     for (int c = 0; c < 3; ++c) r[c] *= s;
     return true;
   }
-};
-
-// A pinned finger (its three joints): r = s (θ − θ_pin) on its block.
-class FingerPinCost : public ceres::SizedCostFunction<9, 9> {
- public:
-  FingerPinCost(const double* target, double s) : s_(s) { std::copy(target, target + 9, target_); }
-  bool Evaluate(double const* const* x, double* r, double** J) const override {
-    for (int c = 0; c < 9; ++c) r[c] = s_ * (x[0][c] - target_[c]);
-    if (J && J[0])
-      for (int i = 0; i < 81; ++i) J[0][i] = i % 10 == 0 ? s_ : 0.0;
-    return true;
-  }
-
- private:
-  double target_[9];
-  double s_;
 };
 
 // The pins' cost w_pin · Σ (wrist², rotation², fingers²) at the current x.
@@ -577,13 +563,14 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     }
     for (const RefineDirections::Pin& p : d->pins) {
       double* x = d->x.data() + p.frame * kX;
-      problem.AddResidualBlock(new WristPinCost(p.wrist - d->j0, d->s_pin), nullptr, x + 48);
+      const Eigen::Vector3d trans = p.wrist - d->j0;
+      problem.AddResidualBlock(new ValuePinCost<3>(trans.data(), d->s_pin), nullptr, x + 48);
       if (p.rotation)
         problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPin, 3, 3>(new RotationPin{*p.rotation, d->s_pin}),
                                  nullptr, x);
       if (p.fingers)
         for (int g = 0; g < 5; ++g)
-          problem.AddResidualBlock(new FingerPinCost(p.fingers->data() + 9 * g, d->s_pin), nullptr, x + 3 + 9 * g);
+          problem.AddResidualBlock(new ValuePinCost<9>(p.fingers->data() + 9 * g, d->s_pin), nullptr, x + 3 + 9 * g);
     }
     // Kept frames stay as they started: every block of theirs constant.
     for (int64_t t = 0; t < d->N; ++t) {

@@ -2,6 +2,7 @@
 #include <ATen/ATen.h>
 
 #include <memory>
+#include <tuple>
 
 #include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/contact_support.h"
@@ -65,11 +66,11 @@ class ContactMapGuidanceStage : public GuidanceStage {
                                                        : io.in<at::Tensor>("contact_maps").unsqueeze(0);
     const auto [held, turning] = held_frames(object, states);
     const at::Tensor top = hits < static_cast<std::int64_t>(object.top.num_vertices());
-    std::unique_ptr<ContactRules> rules;
-    if (io.has("hand_constraints")) rules = std::make_unique<ContactRules>(io.in<HandConstraints>("hand_constraints"), object, hits);
-    const at::Tensor may_hold = rules ? rules->may_hold() : at::Tensor(), may_top = rules ? rules->may_hold_top() : at::Tensor();
+    const HandConstraints* directed = io.has("hand_constraints") ? &io.in<HandConstraints>("hand_constraints") : nullptr;
+    at::Tensor may_hold, may_top;  // undefined: either hand
+    if (directed) std::tie(may_hold, may_top) = hands_that_may_hold(*directed, states.size(0));
     if (hold_) target = diffusion::hold_contacts(target, held, turning, top, place_.threshold, may_hold, may_top);
-    if (rules) target = rules->impose(target, 0, -1, 0);
+    if (directed) target = ContactRules(*directed, object, hits).impose(target, 0, -1, 0);
     auto g = std::make_shared<diffusion::ContactMapGuidance>(points, target, scale_);
     g->set_placement(place_steps_, place_);
     g->set_release(release_steps_);
