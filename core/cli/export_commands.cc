@@ -12,6 +12,7 @@
 #include "core/export/scene_picture.h"
 #include "core/export/scene_source.h"
 #include "core/export/viewer_page.h"
+#include "core/trajectory/trajectory.h"
 #include "core/util/error.h"
 #include "core/util/atomic_file.h"
 
@@ -22,7 +23,7 @@ namespace fs = std::filesystem;
 
 struct ExportOptions {
   std::vector<std::string> sequences;
-  std::string out, mano_left, mano_right, title, frames = "0,30,60";
+  std::string out, mano_left, mano_right, title, frames = "0,30,60", hands;
   bool no_correctives = false, measure_contacts = false;
   int size = 480, columns = 0;
 };
@@ -71,6 +72,19 @@ int run_export(const ExportOptions& o) {
   return 0;
 }
 
+// The constraints of `file` (a trajectory file with a `hands:` block, or a file with only
+// the block) on the sample `s`: `t:` on the file's clock when it is a trajectory, else on
+// the sample's.
+HandConstraints constraints_for(const std::string& file, const SceneSource& s) {
+  Trajectory clock;
+  try {
+    clock = read_trajectory(file, s.sequence.fps);
+  } catch (const Error&) {
+    clock = read_trajectory(s.path);
+  }
+  return read_hand_constraints(file, clock, true);
+}
+
 int run_view(const ExportOptions& o) {
   viewer_bundle_path();  // before any work
   const auto sources = load_all(o);
@@ -84,6 +98,7 @@ int run_view(const ExportOptions& o) {
     v.contacts = viewer_contacts(s.sequence);
     if (v.contacts.empty() && o.measure_contacts) v.contacts = measured_contacts(s);
     v.top_vertices = s.object.top.num_vertices();
+    if (!o.hands.empty()) v.marks = viewer_marks(constraints_for(o.hands, s), s);
     samples.push_back(std::move(v));
   }
   const std::string title = o.title.empty() ? "bimart: " + samples.front().name : o.title;
@@ -140,6 +155,10 @@ void add_export_commands(CLI::App& app, Commands& out) {
     cmd->add_flag("--no-correctives", vw.no_correctives, "leave out the pose-corrective morph targets");
     cmd->add_flag("--measure-contacts", vw.measure_contacts,
                   "for sequences without a contact map: highlight object vertices within 5 mm of the posed hands");
+    cmd->add_option("--hands", vw.hands,
+                    "the trajectory file (or a file with a `hands:` block) the samples were directed with: "
+                    "mark its constraints and pins (docs/directing.md)")
+        ->check(CLI::ExistingFile);
     add_hand_options(cmd, vw);
     out.push_back({cmd, [] { return run_view(vw); }, false});
   }

@@ -26,6 +26,14 @@ const char* contact_part_name(ContactPart p) {
   return "?";
 }
 
+double ContactConstraint::clearance_at(std::int64_t frame) const {
+  if (part != ContactPart::None) return 0;
+  const std::int64_t outside = std::max(frames.first - frame, frame - frames.last);  // > 0 on a ramp
+  if (outside <= 0) return clearance;
+  if (outside > ramp) return 0;
+  return clearance * 0.5 * (1 + std::cos(M_PI * static_cast<double>(outside) / (ramp + 1)));
+}
+
 namespace {
 
 const char* const kHandNames[2] = {"left", "right"};
@@ -89,7 +97,7 @@ struct Parser : YamlReader {
 
   void entry(const YAML::Node& e, int hand, HandConstraints& out) const {
     if (!e.IsMap()) throw Error(at(e), "each entry of a hand must be a map (frames, part, wrist, ...)");
-    check_known_keys(e, {"frames", "frame", "t", "part", "region", "clearance", "wrist", "rotation", "pose"}, file,
+    check_known_keys(e, {"frames", "frame", "t", "part", "region", "clearance", "ramp", "wrist", "rotation", "pose"}, file,
                      "a hand constraint");
     const FrameRange range = frames(e);
     if (!e["part"] && !e["wrist"] && !e["pose"])
@@ -113,9 +121,13 @@ struct Parser : YamlReader {
         c.clearance = number(n, "clearance");
         if (!(c.clearance > 0 && c.clearance <= 0.5)) throw Error(at(n), "clearance must be in (0, 0.5] metres");
       }
+      if (const YAML::Node n = e["ramp"]) {
+        if (c.part != ContactPart::None) throw Error(at(n), "ramp goes with part: none");
+        c.ramp = static_cast<int>(whole(n, "ramp (frames)", 0, 120));
+      }
       out.contacts.push_back(c);
     } else {
-      for (const char* k : {"region", "clearance"})
+      for (const char* k : {"region", "clearance", "ramp"})
         if (e[k]) throw Error(at(e[k]), std::string(k) + " goes with part");
     }
     if (!e["wrist"] && !e["pose"]) {

@@ -58,6 +58,12 @@ struct ContactConstraint {
   std::optional<ContactRegion> region;  // with top/bottom/any: the hand touches inside it
   double clearance = 0.03;              // none: metres between the hand and the object
   SourceLocation where;
+  // none: over this many frames before the range the clearance fades in and after it fades
+  // out (raised cosine), so the hand lets go and comes back smoothly.
+  int ramp = 8;
+  // none: the clearance the hand keeps at `frame` (the full one inside the range, fading on
+  // the ramps, 0 elsewhere); 0 for other parts.
+  double clearance_at(std::int64_t frame) const;
 };
 
 // A hand held at chosen frames: its wrist (MANO's root joint) at `wrist` (world frame, m),

@@ -1,6 +1,7 @@
 #include "core/directing/hand_pins.h"
 
 #include <ATen/ATen.h>
+#include <ATen/Parallel.h>
 #include <fmt/format.h>
 
 #include <Eigen/SVD>
@@ -77,7 +78,14 @@ HandPins::HandPins(const HandConstraints& constraints, const std::array<const Ha
     if (c.part == ContactPart::None) {
       if (c.frames.last >= N)
         throw Error(c.where, fmt::format("frames up to {}, but the trajectory has {} frames", c.frames.last, N));
-      away_.push_back({c.hand, c.frames.first, c.frames.last, c.clearance});
+      away_.push_back(c);
+      for (std::int64_t f = std::max<std::int64_t>(0, c.frames.first - c.ramp); f <= std::min(c.frames.last + c.ramp, N - 1); ++f) {
+        if (trees_.count(f)) continue;
+        const at::Tensor pd = points_[f].to(at::kDouble).contiguous();
+        Points3 pts = Eigen::Map<const Points3>(pd.data_ptr<double>(), pd.size(0), 3);
+        centres_[f] = pts.colwise().mean().transpose();
+        trees_.emplace(f, NearestPoints(std::move(pts)));
+      }
     }
 }
 
@@ -103,6 +111,39 @@ std::pair<Eigen::Vector3d, Eigen::Matrix3d> HandPins::wrist_of(const at::Tensor&
   const Eigen::Isometry3d to_world = object_pose_at(states_, frame);
   return {to_world * w, to_world.linear() * R};
 }
+
+namespace {
+
+// The smallest α ≥ 0 that puts every keypoint k_j + α·d at least `need` from every object
+// point. Along the line each keypoint-point pair is too close over an interval of α (the
+// roots of |k − p + α d|² = need²); α steps past the end of every interval that holds it
+// (the pairs closer than `need` at the current α, from the k-d tree) until none does.
+double clearing_shift(const Points3& keys, const Eigen::Vector3d& d, const NearestPoints& tree,
+                      double need) {
+  // A hand whose keypoints' bounding ball is clear of the nearest point needs nothing.
+  const Eigen::Vector3d centre = keys.colwise().mean().transpose();
+  const double reach = (keys.rowwise() - centre.transpose()).rowwise().norm().maxCoeff();
+  if (std::sqrt(tree.nearest(centre).distance_sq) >= reach + need) return 0;
+  double alpha = 0;
+  std::vector<int> hits;
+  for (int step = 0; step < 1000; ++step) {
+    double next = alpha;
+    for (Eigen::Index j = 0; j < keys.rows(); ++j) {
+      const Eigen::Vector3d k = keys.row(j).transpose();
+      tree.within(k + alpha * d, need, &hits);
+      for (int i : hits) {
+        const Eigen::Vector3d a = k - tree.points().row(i).transpose();
+        const double ad = a.dot(d), disc = ad * ad - a.squaredNorm() + need * need;
+        if (disc > 0) next = std::max(next, -ad + std::sqrt(disc) + 1e-6);
+      }
+    }
+    if (next == alpha) break;
+    alpha = next;
+  }
+  return alpha;
+}
+
+}  // namespace
 
 at::Tensor HandPins::impose(const at::Tensor& x0, std::int64_t first, int /*step*/, int /*num_steps*/) const {
   if (empty()) return x0;
@@ -150,25 +191,34 @@ at::Tensor HandPins::impose(const at::Tensor& x0, std::int64_t first, int /*step
   at::Tensor change = spread / weight.clamp_min(1.0).view({1, T, 2, 1, 1});
   change = at::where(pinned.view({1, T, 2, 1, 1}), exact, change);
   at::Tensor Hn = H + change;
-  // Hands kept off the object: moved away from their nearest object point, a few rounds.
-  for (const Away& a : away_) {
-    const std::int64_t s0 = std::max(a.first - first, std::int64_t{0}), s1 = std::min(a.last - first + 1, T);
-    for (std::int64_t s = s0; s < s1; ++s) {
-      const at::Tensor P = points_[first + s];  // [1024, 3]
-      for (std::int64_t b = 0; b < B; ++b) {
-        at::Tensor k = Hn[b][s][a.hand];  // view
-        for (int round = 0; round < 4; ++round) {
-          const at::Tensor d = at::cdist(k.unsqueeze(0), P.unsqueeze(0)).squeeze(0);  // [J, 1024]
-          const auto [dmin, pi] = d.view({-1}).min(0);
-          const float gap = dmin.item<float>();
-          if (gap >= a.clearance) break;
-          const std::int64_t i = pi.item<std::int64_t>();
-          at::Tensor dir = k[i / P.size(0)] - P[i % P.size(0)];
-          dir = gap > 1e-6f ? dir / gap : at::tensor({0.f, 1.f, 0.f});
-          k += (static_cast<float>(a.clearance) - gap + 1e-4f) * dir;
-        }
+  // Hands kept off the object: moved rigidly away from the object (from the centre of its
+  // points towards the hand's keypoints) until every keypoint is the clearance off every
+  // object point. Away from the nearest point alone fails for a hand that is inside the
+  // object or wraps it: the nearest point then lies on the far side. On the ramps around the
+  // range the clearance fades (ContactConstraint::clearance_at), so the hand lets go and
+  // comes back smoothly instead of jumping at the range's ends.
+  Hn = Hn.contiguous();
+  float* const hp = Hn.data_ptr<float>();
+  for (const ContactConstraint& a : away_) {
+    const std::int64_t s0 = std::max(a.frames.first - a.ramp - first, std::int64_t{0}),
+                       s1 = std::min(a.frames.last + a.ramp - first + 1, T);
+    if (s0 >= s1) continue;
+    // Frames (and samples) are independent: spread over the cores.
+    at::parallel_for(0, (s1 - s0) * B, 1, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t task = begin; task < end; ++task) {
+        const std::int64_t s = s0 + task / B, b = task % B, f = first + s;
+        const double need = a.clearance_at(f);
+        if (need <= 0) continue;
+        float* k = hp + ((b * T + s) * 2 + a.hand) * J * 3;  // [J, 3]
+        Points3 keys(J, 3);
+        for (std::int64_t i = 0; i < J * 3; ++i) keys.data()[i] = k[i];
+        Eigen::Vector3d d = keys.colwise().mean().transpose() - centres_.at(f);
+        d = d.norm() > 1e-9 ? d.normalized() : Eigen::Vector3d::UnitY();
+        const double alpha = clearing_shift(keys, d, trees_.at(f), need);
+        for (std::int64_t j = 0; alpha > 0 && j < J; ++j)
+          for (int c = 0; c < 3; ++c) k[j * 3 + c] += static_cast<float>(alpha * d[c]);
       }
-    }
+    });
   }
   const at::Tensor moved = (Hn - H).reshape({B, T, 600});
   return at::cat({Hn.reshape({B, T, 600}), x0.slice(-1, 600, 1200).to(at::kFloat) - moved}, -1).to(x0.scalar_type());

@@ -8,7 +8,8 @@
 //   pose pin      the hand's keypoints replaced by those of the sample's hand at its frame,
 //                 relative to the object as they were there;
 //   part: none    a hand whose keypoints come within `clearance` of the object points is
-//                 moved straight away from the nearest one until they do not.
+//                 moved rigidly away from the object until they do not (the clearance
+//                 fading in and out over the constraint's ramp frames around its range).
 // A pinned frame's change of every keypoint also moves the frames around it, weighted by
 // a Gaussian of `sigma` frames (the pinned frames exactly), so the motion runs smoothly into
 // the pin. D moves opposite to H, so H + D (the object point each keypoint refers to) stays.
@@ -16,12 +17,14 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include <ATen/core/Tensor.h>
 #include <Eigen/Core>
 
 #include "core/directing/hand_constraints.h"
+#include "core/geometry/nearest_points.h"
 #include "core/hand/hand_model.h"
 #include "stages/sample_constraint.h"
 
@@ -61,12 +64,10 @@ class HandPins : public SampleConstraint {
 
   std::array<Palm, 2> palms_;
   std::vector<Target> targets_;
-  struct Away {
-    int hand;
-    std::int64_t first, last;
-    double clearance;
-  };
-  std::vector<Away> away_;
+  std::vector<ContactConstraint> away_;  // part: none
+  // Per frame a hand is kept off at (ramps included): the object points' k-d tree and centre.
+  std::map<std::int64_t, NearestPoints> trees_;
+  std::map<std::int64_t, Eigen::Vector3d> centres_;
   at::Tensor states_;  // [N, 7] float64
   at::Tensor points_;  // [N, 1024, 3] float32
   double sigma_;

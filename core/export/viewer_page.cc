@@ -67,6 +67,11 @@ html, body { margin: 0; height: 100%; font: 14px system-ui, sans-serif; backgrou
 #slider { flex: 1; min-width: 80px; }
 #frame { font-variant-numeric: tabular-nums; min-width: 8em; }
 #status { color: #a00; }
+#marks { position: absolute; top: 44px; left: 0; width: 100%; height: 34px; background: #fff; border-bottom: 1px solid #ccc;
+         font-size: 12px; }
+#timeline { position: absolute; left: 8px; top: 3px; width: calc(100% - 16px); height: 14px; }
+#now { position: absolute; left: 8px; top: 18px; white-space: nowrap; overflow: hidden; width: calc(100% - 16px); }
+body.directed #view { top: 79px; height: calc(100% - 79px); }
 .key { display: inline-block; width: 10px; height: 10px; border-radius: 2px; margin-right: 3px; }
 )";
 
@@ -147,6 +152,12 @@ std::string viewer_page(const std::vector<ViewerSample>& samples, const std::str
       }
       j["contacts"] = {{"top", s.top_vertices}, {"frames", std::move(frames)}};
     }
+    for (const ViewerMark& m : s.marks) {
+      nlohmann::json mj{{"hand", m.hand}, {"first", m.first}, {"last", m.last}, {"kind", m.kind}, {"label", m.label}};
+      if (!m.wrists.empty()) mj["wrists"] = m.wrists;
+      if (m.region_point) mj["region"] = {{"point", *m.region_point}, {"radius", m.region_radius}, {"part", m.region_part}};
+      j["marks"].push_back(std::move(mj));
+    }
     data["samples"].push_back(std::move(j));
   }
   std::ostringstream html;
@@ -166,6 +177,7 @@ std::string viewer_page(const std::vector<ViewerSample>& samples, const std::str
        << "<span class=\"key\" style=\"background:#e60d0d\"></span>left "
        << "<span class=\"key\" style=\"background:#8c0dd9\"></span>right</label>"
        << "<span id=\"status\">loading…</span></div>\n"
+       << "<div id=\"marks\" hidden><canvas id=\"timeline\"></canvas><span id=\"now\"></span></div>\n"
        << "<canvas id=\"view\"></canvas>\n"
        << "<script type=\"application/json\" id=\"bimart-data\">" << script_safe(data.dump()) << "</script>\n"
        << "<script>\n" << script_safe(bundle) << "\n</script>\n</body>\n</html>\n";

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/export/scene_source.h"
+#include "core/export/viewer_marks.h"
 #include "core/io/sequence.h"
 
 namespace bimart {
@@ -25,6 +26,7 @@ struct ViewerSample {
   // a hand, with that hand (0 left, 1 right); empty when the sequence holds no contact map.
   std::vector<std::vector<std::pair<std::int64_t, int>>> contacts;
   std::int64_t top_vertices = 0;  // to split the ids into top and bottom
+  std::vector<ViewerMark> marks;   // a directed run's constraints (core/export/viewer_marks.h)
 };
 
 // A sample's contacts from the sequence's `contact_maps` and `basis_hit_indices` (none when

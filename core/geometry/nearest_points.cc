@@ -58,4 +58,15 @@ void NearestPoints::nearest(const Points3& queries, int* indices, double* distan
   }
 }
 
+void NearestPoints::within(const Eigen::Vector3d& q, double radius, std::vector<int>* indices) const {
+  check_point(q, "nearest-point query");
+  const double query[3] = {q.x(), q.y(), q.z()};
+  std::vector<std::pair<std::uint32_t, double>> hits;
+  // L2_Simple_Adaptor compares squared distances: the radius goes in squared.
+  tree_->index.radiusSearch(query, radius * radius, hits, nanoflann::SearchParams(32, 0, false));
+  indices->clear();
+  for (const auto& h : hits)
+    if (h.second < radius * radius) indices->push_back(static_cast<int>(h.first));
+}
+
 }  // namespace bimart

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "core/geometry/triangle_mesh.h"
 
@@ -25,6 +26,9 @@ class NearestPoints {
   Hit nearest(const Eigen::Vector3d& query) const;
   // For each row of `queries`: the nearest point's index and squared distance.
   void nearest(const Points3& queries, int* indices, double* distances_sq) const;
+
+  // The indices of every point closer than `radius` to `query`, in no particular order.
+  void within(const Eigen::Vector3d& query, double radius, std::vector<int>* indices) const;
 
   const Points3& points() const;
   Eigen::Index size() const { return points().rows(); }

@@ -30,7 +30,14 @@ class Problems {
 };
 
 // Converts a YAML value to the parameter's type; throws a message (without location).
-ParamValue convert(const YAML::Node& node, ParamType type) {
+ParamValue convert(const YAML::Node& node, ParamType type, bool yaml_text) {
+  if (yaml_text && (node.IsMap() || node.IsSequence())) {
+    YAML::Emitter flow;
+    flow.SetMapFormat(YAML::Flow);
+    flow.SetSeqFormat(YAML::Flow);
+    flow << node;
+    return std::string(flow.c_str());
+  }
   auto scalar_text = [&]() -> std::string {
     if (node.IsNull()) throw std::runtime_error("has no value");
     if (!node.IsScalar()) throw std::runtime_error("expects " + with_article(type) + ", got a list or mapping");
@@ -140,7 +147,7 @@ Graph validate(const GraphFile& file, const Registry& registry) {
         continue;
       }
       try {
-        n.params.set(p.name, convert(value, ps->type));
+        n.params.set(p.name, convert(value, ps->type, ps->yaml_text));
       } catch (const std::runtime_error& e) {
         const bool substituted = value.IsScalar() && p.value.IsScalar() && value.Scalar() != p.value.Scalar();
         problems.add(w, describe_stage(s) + " parameter '" + p.name + "' " + e.what() +

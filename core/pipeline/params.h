@@ -28,6 +28,9 @@ struct ParamSpec {
   ParamType type = ParamType::Float;
   ParamValue default_value;
   std::string help;
+  // A string parameter whose value may also be written as a YAML list or mapping (in the
+  // pipeline file or with --set); the stage gets its YAML flow text and parses it.
+  bool yaml_text = false;
 };
 
 // Validated parameter values of one stage: every parameter of its schema is present

@@ -46,6 +46,12 @@ StageSpec& StageSpec::param(const std::string& n, std::vector<std::string> v, co
   return add_param(n, std::move(v), h);
 }
 
+StageSpec& StageSpec::yaml_param(const std::string& n, const std::string& h) {
+  add_param(n, std::string(), h);
+  params.back().yaml_text = true;
+  return *this;
+}
+
 StageSpec& StageSpec::add_port(std::vector<PortSpec>& ports, PortSpec port) {
   ports.push_back(std::move(port));
   return *this;

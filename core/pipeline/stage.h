@@ -63,6 +63,9 @@ class StageSpec {
   StageSpec& param(const std::string& name, std::vector<std::int64_t> default_value, const std::string& help);
   StageSpec& param(const std::string& name, std::vector<double> default_value, const std::string& help);
   StageSpec& param(const std::string& name, std::vector<std::string> default_value, const std::string& help);
+  // A string parameter that also takes a YAML list or mapping, handed over as its flow text
+  // (ParamSpec::yaml_text); default "".
+  StageSpec& yaml_param(const std::string& name, const std::string& help);
 
   template <class T>
   StageSpec& input(const std::string& name, const std::string& help) {

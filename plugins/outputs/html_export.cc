@@ -2,6 +2,7 @@
 // (stages/samples.h) on one page.
 #include <filesystem>
 
+#include "core/directing/hand_constraints.h"
 #include "core/export/gltf_scene.h"
 #include "core/export/viewer_page.h"
 #include "core/util/log.h"
@@ -16,6 +17,7 @@ class HtmlExport : public Exporter {
   static StageSpec spec() {
     StageSpec s = StageSpec::of<Exporter>("html", "a self-contained viewer page (three.js, no network)");
     outputs_plugin::declare_scene_inputs(s);
+    s.optional_input<HandConstraints>("hand_constraints", "a directed run's constraints, marked on the page (docs/directing.md)");
     s.param("path", "out/viewer.html", "file to write (folders are created)")
         .param("correctives", true, "pose correctives as morph targets in the embedded scene");
     return s;
@@ -42,6 +44,7 @@ class HtmlExport : public Exporter {
       sample.glb = build_glb(src.sequence, src.object, src.models(), o);
       sample.contacts = viewer_contacts(src.sequence);
       sample.top_vertices = src.object.top.num_vertices();
+      if (io.has("hand_constraints")) sample.marks = viewer_marks(io.in<HandConstraints>("hand_constraints"), src);
       pages.push_back(std::move(sample));
     }
     const auto bytes = write_viewer_page(pages, name, path_);

@@ -39,7 +39,7 @@ class FileTrajectory : public TrajectorySource {
         .param("object_dir", "",
                "folder a procedural object is written to, for exporters (default: ~/.cache/bimart/objects/"
                "CATEGORY_SEED)")
-        .param("hands", "",
+        .yaml_param("hands",
                "more hand constraints (docs/directing.md): a YAML file with a `hands:` block, or the block's value "
                "inline, e.g. '{right: [{frames: [0, 40], part: top}]}'; added to the trajectory file's own")
         .param("redraw", std::vector<std::int64_t>{},

@@ -1,6 +1,7 @@
 // Diffusion models on the CPU: training throughput (windows/s) per network size, sampling
 // one 64-frame window (contact + motion with CFG and contact-map guidance, 50 DDPM steps or
-// 10 DDIM steps; 1 or 10 samples), and one guidance step. Random weights: speed only.
+// 10 DDIM steps; 1 or 10 samples), the same window directed (docs/directing.md), and one
+// guidance step. Random weights: speed only.
 // Run: bimart_benchmarks --benchmark_filter=Diffusion   (docs/performance.md, "Diffusion")
 #include <benchmark/benchmark.h>
 
@@ -13,6 +14,11 @@
 #include "core/diffusion/contact_guidance.h"
 #include "core/diffusion/generation.h"
 #include "core/diffusion/schedule.h"
+#include "core/directing/contact_rules.h"
+#include "core/directing/hand_pins.h"
+#include "core/geometry/rotation.h"
+#include "bench_object.h"
+#include "tests/synth/shipped_hands.h"
 #include "core/runtime/blas.h"
 
 namespace bimart::diffusion {
@@ -117,6 +123,71 @@ BENCHMARK(BM_DiffusionSampleWindow)
     ->Args({3, 1, 10})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// One 64-frame window of the shipped size (contact + motion, 1 sample, DDPM 50, guidance),
+// unconstrained (arg 0) or directed (arg 1): the right hand on the top part throughout, the
+// left hand kept off for 20 frames, the right wrist pinned (with its orientation) at two
+// frames — each constraint imposed on all 50 steps of its sampler.
+void BM_DiffusionSampleWindowDirected(benchmark::State& state) {
+  runtime::set_threads(2);
+  const bool directed = state.range(0) != 0;
+  const auto contact = random_model("contact", 0), motion = random_model("motion", 0);
+  const at::Tensor O = at::randn({64, 1024, 3}), G = at::randn({64, 7});
+  const ArticulatedObject& object = bench::bench_object();
+  const std::int64_t top = object.top.num_vertices(), bottom = object.bottom.num_vertices();
+  const at::Tensor hits = at::cat({at::arange(512) % top, top + at::arange(512) % bottom}).unsqueeze(0).expand({64, 1024}).contiguous();
+  // The object points: the hit vertices of the closed object (its surface, as in a run).
+  at::Tensor vertices = at::empty({top + bottom, 3}, at::kDouble);
+  std::copy(object.top.vertices.data(), object.top.vertices.data() + 3 * top, vertices.data_ptr<double>());
+  std::copy(object.bottom.vertices.data(), object.bottom.vertices.data() + 3 * bottom, vertices.data_ptr<double>() + 3 * top);
+  const at::Tensor points = vertices.to(at::kFloat).index_select(0, hits[0]).unsqueeze(0).expand({64, 1024, 3}).contiguous();
+  HandConstraints c;
+  c.contacts.push_back({1, {0, 63}, ContactPart::Top, std::nullopt, 0.03, {}});
+  c.contacts.push_back({0, {10, 29}, ContactPart::None, std::nullopt, 0.03, {}});
+  for (std::int64_t f : {32, 63}) {
+    HandPin pin;
+    pin.hand = 1;
+    pin.frames = {f, f};
+    pin.wrist = Eigen::Vector3d(0.05, 0.3, -0.1);
+    pin.rotation = Eigen::Quaterniond(axis_angle_to_matrix(Eigen::Vector3d(0, 1.2, 0)));
+    c.pins.push_back(pin);
+  }
+  const ContactRules rules(c, object, hits);
+  const HandPins pins(c, test::shipped_hands(), at::zeros({64, 7}, at::kDouble), points);
+  GenerateOptions o;
+  o.samples = 1;
+  auto gen = at::detail::createCPUGenerator(2);
+  for (auto _ : state) {
+    const at::Tensor C = contact->generate(O, G, {}, nullptr, o, gen, directed ? &rules : nullptr);
+    const ContactMapGuidance guidance(points, C, 1.0);
+    benchmark::DoNotOptimize(motion->generate(O, G, C, &guidance, o, gen, directed ? &pins : nullptr));
+  }
+  state.SetLabel(directed ? "tiny (shipped), 1 sample, DDPM 50, directed" : "tiny (shipped), 1 sample, DDPM 50");
+}
+BENCHMARK(BM_DiffusionSampleWindowDirected)->Arg(0)->Arg(1)->MinTime(6)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// One step's in-painting of HandPins on a 64-frame window: two wrist pins with their
+// orientation (arg 0) or a hand kept off for 20 frames (arg 1).
+void BM_HandPinsImpose(benchmark::State& state) {
+  runtime::set_threads(2);
+  const at::Tensor points = at::rand({64, 1024, 3}) * 0.2;
+  HandConstraints c;
+  if (state.range(0) == 1) c.contacts.push_back({0, {10, 29}, ContactPart::None, std::nullopt, 0.03, {}});
+  for (std::int64_t f : {32, 63}) {
+    if (state.range(0) == 1) break;
+    HandPin pin;
+    pin.hand = 1;
+    pin.frames = {f, f};
+    pin.wrist = Eigen::Vector3d(0.05, 0.3, -0.1);
+    pin.rotation = Eigen::Quaterniond(axis_angle_to_matrix(Eigen::Vector3d(0, 1.2, 0)));
+    c.pins.push_back(pin);
+  }
+  const HandPins pins(c, test::shipped_hands(), at::zeros({64, 7}, at::kDouble), points);
+  const at::Tensor x0 = at::rand({1, 64, 1200}) * 0.2;
+  for (auto _ : state) benchmark::DoNotOptimize(pins.impose(x0, 0, 10, 50));
+  state.SetLabel(state.range(0) == 0 ? "64 frames, 2 wrist pins" : "64 frames, a hand kept off for 20 frames");
+}
+BENCHMARK(BM_HandPinsImpose)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_DiffusionGuidanceStep(benchmark::State& state) {
   runtime::set_threads(static_cast<int>(state.range(0)));

@@ -278,6 +278,18 @@ TEST(Graph, OverridesReplaceAndAddParameters) {
   EXPECT_EQ(g.seed, 11u);
 }
 
+TEST(Graph, YamlTextParametersTakeScalarsListsAndMappings) {
+  EXPECT_EQ(load(kGood).node("src").params.string("extra"), "");
+  EXPECT_EQ(load(kGood, {"src.extra=notes.yaml"}).node("src").params.string("extra"), "notes.yaml");
+  EXPECT_EQ(load(kGood, {"src.extra={right: [{frames: [0, 4], part: top}]}"}).node("src").params.string("extra"),
+            "{right: [{frames: [0, 4], part: top}]}");
+  const std::string in_file = std::string(kGood).replace(std::string(kGood).find("{value: 2.5}"), 12,
+                                                        "{value: 2.5, extra: [1, {a: b}]}");
+  EXPECT_EQ(load(in_file).node("src").params.string("extra"), "[1, {a: b}]");
+  // Other parameters still refuse a mapping.
+  EXPECT_HAS(error_of(kGood, {"src.count={a: 1}"}), "parameter 'count' expects an int, got a list or mapping");
+}
+
 TEST(Graph, OverrideErrorsNameTheOverride) {
   EXPECT_HAS(error_of(kGood, {"src.valeu=9"}), "--set src.valeu=9: stage 'src' (test.source) has no parameter 'valeu'");
   EXPECT_HAS(error_of(kGood, {"src.count=abc"}), "--set src.count=abc: stage 'src' parameter 'count' expects an int, got 'abc'");

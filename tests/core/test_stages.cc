@@ -16,6 +16,7 @@ struct Source : Stage {
     return StageSpec("test.source", "a number")
         .param("value", 1.0, "the number")
         .param("count", 3, "unused")
+        .yaml_param("extra", "unused; YAML text")
         .output<double>("value", "the number");
   }
   explicit Source(const Params& p) : v(p.number("value")) {}

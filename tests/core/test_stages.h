@@ -5,7 +5,7 @@
 
 namespace bimart::test {
 
-// test.source   out value:float            params value=1.0, count=3
+// test.source   out value:float            params value=1.0, count=3, extra (YAML text)
 // test.double   in value:float -> out value:float (x2)
 // test.sink     in value:float, optional extra:string -> out result:string
 // test.text     out value:string

@@ -18,6 +18,7 @@
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
 #include "core/object/families/families.h"
+#include "core/trajectory/trajectory.h"
 #include "tests/error_of.h"
 #include "tests/synth/shipped_hands.h"
 
@@ -52,6 +53,7 @@ TEST(HandConstraints, ReadsTheBlockOfATrajectoryFile) {
                                       "  left:\n"
                                       "    - t: [1.5, 2.5]\n"
                                       "      part: none\n"
+                                      "      ramp: 4\n"
                                       "    - frame: 70\n"
                                       "      wrist: [0.1, 0.2, 0.3]\n"
                                       "      rotation: {euler_xyz: [0, 90, 0]}\n"
@@ -70,6 +72,12 @@ TEST(HandConstraints, ReadsTheBlockOfATrajectoryFile) {
   EXPECT_EQ(c.contacts[1].frames.first, 30);
   EXPECT_EQ(c.contacts[1].frames.last, 60);
   EXPECT_DOUBLE_EQ(c.contacts[1].clearance, 0.03);
+  // The clearance fades over the 4-frame ramps: full in the range, raised cosine, then none.
+  EXPECT_DOUBLE_EQ(c.contacts[1].clearance_at(45), 0.03);
+  EXPECT_NEAR(c.contacts[1].clearance_at(28), 0.03 * 0.5 * (1 + std::cos(M_PI * 2 / 5)), 1e-12);
+  EXPECT_EQ(c.contacts[1].clearance_at(25), 0.0);
+  EXPECT_EQ(c.contacts[1].clearance_at(65), 0.0);
+  EXPECT_EQ(c.contacts[0].clearance_at(10), 0.0);  // not a `none` constraint
   EXPECT_EQ(c.contacts[2].hand + c.contacts[3].hand, 1);  // both: one each
   ASSERT_EQ(c.pins.size(), 1u);
   EXPECT_EQ(c.pins[0].frames.first, 70);
@@ -84,6 +92,31 @@ TEST(HandConstraints, ReadsTheBlockOfATrajectoryFile) {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+
+// The shipped examples with a `hands:` block read cleanly; each kind of constraint is used
+// by one of them; the pose example (a hands file) names the sample it needs until it exists.
+TEST(HandConstraints, ShippedExamplesRead) {
+  const std::string dir = std::string(BIMART_SOURCE_DIR) + "/examples/trajectories/";
+  bool part = false, none = false, region = false, wrist = false, rotation = false;
+  for (const char* name : {"laptop_lift_open_directed.yaml", "box_carry_open_left_free.yaml", "box_open_lid_edge.yaml"}) {
+    const HandConstraints c = read_hand_constraints(dir + name, read_trajectory(dir + name), true);
+    for (const auto& k : c.contacts) {
+      (k.part == ContactPart::None ? none : part) = true;
+      region = region || k.region.has_value();
+    }
+    for (const auto& p : c.pins) {
+      wrist = wrist || p.wrist.has_value();
+      rotation = rotation || p.rotation.has_value();
+    }
+  }
+  EXPECT_TRUE(part && none && region && wrist && rotation);
+  const std::string pose = dir + "laptop_right_pose_from_sample.yaml";
+  const Trajectory laptop = read_trajectory(dir + "laptop_lift_open.yaml");
+  if (!std::filesystem::exists(std::string(BIMART_SOURCE_DIR) + "/out/laptop/sample_0.npz"))
+    EXPECT_THAT(test::error_of([&] { read_hand_constraints(pose, laptop, true); }),
+                AllOf(HasSubstr("laptop_right_pose_from_sample.yaml:11:"),
+                      HasSubstr("pose.sample: no sequence file"), HasSubstr("out/laptop/sample_0.npz")));
+}
 
 TEST(HandConstraints, MistakesNameTheFileAndLine) {
   const auto err = [](const std::string& body) {
@@ -104,6 +137,8 @@ TEST(HandConstraints, MistakesNameTheFileAndLine) {
   EXPECT_THAT(err("  left:\n    - frame: 3\n      part: top\n      rotation: {euler_xyz: [0, 0, 0]}\n"),
               AllOf(HasSubstr("bad.yaml:"), HasSubstr("rotation goes with wrist")));
   EXPECT_THAT(err("  left:\n    - t: 9\n      part: top\n"), AllOf(HasSubstr("bad.yaml:4:"), HasSubstr("outside the trajectory")));
+  EXPECT_THAT(err("  left:\n    - part: top\n      ramp: 4\n"), AllOf(HasSubstr("bad.yaml:5:"), HasSubstr("ramp goes with part: none")));
+  EXPECT_THAT(err("  left:\n    - part: none\n      ramp: -1\n"), AllOf(HasSubstr("bad.yaml:5:"), HasSubstr("ramp")));
   EXPECT_THAT(err("  left:\n    - frame: 3\n      pose: {sample: nowhere.npz, frame: 2}\n"),
               AllOf(HasSubstr("bad.yaml:5:"), HasSubstr("no sequence file")));
   // A file given for its constraints must have the block; inline text is read the same way.
@@ -220,12 +255,42 @@ TEST(HandPins, AHandKeptOffStaysItsClearanceFromTheObjectPoints) {
   // Object points right at the left hand's first keypoint in frames 2..5.
   for (int t = 2; t <= 5; ++t) pc.points[t][0] = pc.hand(pc.X, t, 0)[0] + at::tensor({0.0f, 0.005f, 0.0f});
   HandConstraints c;
-  c.contacts.push_back({0, {2, 4}, ContactPart::None, std::nullopt, 0.03, {}});
+  c.contacts.push_back({0, {2, 4}, ContactPart::None, std::nullopt, 0.03, {}, 0});  // no ramp
   const HandPins pins(c, test::shipped_hands(), pc.states, pc.points, 0.0);
   const at::Tensor out = pins.impose(pc.X, 0, 0, 1000);
   for (int t = 2; t <= 4; ++t)
     EXPECT_GE(at::cdist(pc.hand(out, t, 0).unsqueeze(0), pc.points[t].unsqueeze(0)).min().item<float>(), 0.03f);
   EXPECT_TRUE(at::equal(pc.hand(out, 5, 0), pc.hand(pc.X, 5, 0)));  // outside the range
+}
+
+// A hand inside the object (a ball of points around its palm, smaller than the hand) is
+// moved out of it whole, not further in towards the far side; on the constraint's ramp the
+// frames before and after the range are moved by a clearance that fades out.
+TEST(HandPins, AHandInsideTheObjectIsMovedOutAndLetsGoSmoothly) {
+  PinCase pc;
+  at::manual_seed(3);
+  for (int t = 0; t < PinCase::N; ++t) {
+    const at::Tensor centre = pc.hand(pc.X, t, 1).mean(0) + at::tensor({0.01f, 0.0f, 0.0f});
+    const at::Tensor dirs = at::randn({1024, 3}, at::TensorOptions().dtype(at::kFloat));
+    pc.points[t] = centre + 0.06f * dirs / dirs.norm(2, 1, true);
+  }
+  HandConstraints c;
+  c.contacts.push_back({1, {4, 5}, ContactPart::None, std::nullopt, 0.03, {}, 2});  // a ramp of 2 frames
+  const HandPins pins(c, test::shipped_hands(), pc.states, pc.points, 0.0);
+  const at::Tensor out = pins.impose(pc.X, 0, 0, 1000);
+  const auto gap = [&](const at::Tensor& x, int t) {
+    return at::cdist(pc.hand(x, t, 1).unsqueeze(0), pc.points[t].unsqueeze(0)).min().item<float>();
+  };
+  for (int t = 4; t <= 5; ++t) {
+    EXPECT_LT(gap(pc.X, t), 0.01f);
+    EXPECT_GE(gap(out, t), 0.03f) << "frame " << t;
+  }
+  // The ramp: frames 2-3 and 6-7 moved out part of the way (less than the range), 0-1 and 8 not at all.
+  for (int t : {3, 6}) {
+    EXPECT_GE(gap(out, t), 0.5f * 0.03f) << "frame " << t;
+    EXPECT_LT(gap(out, t), 0.03f) << "frame " << t;
+  }
+  for (int t : {0, 1, 8}) EXPECT_TRUE(at::equal(pc.hand(out, t, 1), pc.hand(pc.X, t, 1))) << "frame " << t;
 }
 
 TEST(KeptSample, WeightsKeepTheOutsideExactlyAndRampAtJoins) {

@@ -12,6 +12,7 @@
 #include "core/export/gltf_scene.h"
 #include "core/export/scene_picture.h"
 #include "core/export/viewer_page.h"
+#include "core/hand/lbs.h"
 #include "core/io/sequence.h"
 #include "core/object/object_io.h"
 #include "tests/cli/run_bimart.h"
@@ -152,6 +153,84 @@ TEST(ViewerPage, EmbedsTheSceneAndTheContacts) {
   EXPECT_EQ(hits, close.sum().item<std::int64_t>());
   EXPECT_EQ(page.find("http://"), std::string::npos);
   EXPECT_EQ(page.find("https://"), std::string::npos);
+}
+
+// A directed run's marks: ranges cut to the sequence, regions on their part, and a pose pin's
+// wrist exactly the sample's at its own frame and carried rigidly with the object after it.
+TEST(ViewerPage, MarksConstraintsPinsAndRedrawnStretch) {
+  const Scene& sc = scene();
+  const fs::path dir = fs::temp_directory_path() / ("bimart_marks_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const Sequence s = test::test_sequence(30, sc.plain());
+  write_sequence(s, (dir / "sample.npz").string());
+  SceneSource src{(dir / "sample.npz").string(), s, sc.object, std::make_shared<std::array<HandModel, 2>>(sc.shipped)};
+
+  HandConstraints c;
+  const Eigen::Vector3d on_top = sc.object.top.vertices.row(5).transpose(),
+                        on_bottom = sc.object.bottom.vertices.row(7).transpose();
+  c.contacts.push_back({1, {0, 20}, ContactPart::Top, ContactRegion{on_top, 0.03}, 0.03, {}});
+  c.contacts.push_back({0, {5, 10}, ContactPart::None, std::nullopt, 0.03, {}});
+  c.contacts.push_back({0, {11, 15}, ContactPart::Any, ContactRegion{on_bottom, 0.02}, 0.03, {}});
+  HandPin wrist;
+  wrist.hand = 0;
+  wrist.frames = {12, 12};
+  wrist.wrist = Eigen::Vector3d(0.1, 0.2, 0.3);
+  HandPin pose;
+  pose.hand = 1;
+  pose.frames = {25, 40};  // past the last frame: cut to 29
+  pose.source = (dir / "sample.npz").string();
+  pose.source_frame = 25;
+  c.pins = {wrist, pose};
+  c.keep = KeptSample{"sample.npz", {10, 20}, true, 8};
+
+  const std::vector<ViewerMark> m = viewer_marks(c, src);
+  ASSERT_EQ(m.size(), 7u);
+  EXPECT_EQ(m[0].kind, "top");
+  EXPECT_EQ(m[0].region_part, "top");
+  EXPECT_NE(m[0].label.find("right: on the top part within 3 cm of a point, frames 0-20"), std::string::npos) << m[0].label;
+  EXPECT_EQ(m[1].kind, "none");
+  EXPECT_FALSE(m[1].region_point);
+  EXPECT_EQ(m[2].region_part, "bottom");  // `any` with a point on the bottom part
+  EXPECT_EQ(m[3].kind, "wrist");
+  ASSERT_EQ(m[3].wrists.size(), 1u);
+  EXPECT_EQ(m[3].wrists[0], (std::array<double, 3>{0.1, 0.2, 0.3}));
+  EXPECT_EQ(m[4].kind, "pose");
+  EXPECT_EQ(m[4].last, 29);
+  ASSERT_EQ(m[4].wrists.size(), 5u);
+  const HandParams& r = s.hands.hands[1];
+  const auto vec = [](const at::Tensor& t) {
+    const at::Tensor d = t.to(at::kDouble).contiguous();
+    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel()));
+  };
+  const Eigen::Vector3d j0 = lbs<double>(sc.shipped[1], Eigen::Vector3d(vec(r.rot[25])), vec(r.pose[25]),
+                                         Eigen::Vector3d(vec(r.trans[25])), vec(r.shape))
+                                 .joints.row(0)
+                                 .transpose();
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(m[4].wrists[0][k], j0[k], 1e-6);
+  const auto to_object = [&](int f) {
+    const Eigen::Vector3d w(m[4].wrists[f - 25].data());
+    return (object_pose_at(s.object_states, f).inverse() * w).eval();
+  };
+  for (int f = 26; f <= 29; ++f) EXPECT_LT((to_object(f) - to_object(25)).norm(), 1e-6) << "frame " << f;
+  EXPECT_EQ(m[5].kind, "redraw");
+  EXPECT_EQ(m[5].hand, -1);
+  EXPECT_EQ(m[5].first, 10);
+  EXPECT_EQ(m[6].kind, "contacts");
+  EXPECT_EQ(m[6].last, 29);
+
+  ViewerSample v;
+  v.name = "directed";
+  v.frames = 30;
+  v.glb = "x";
+  v.marks = m;
+  const std::string page = viewer_page({v}, "t", "/* bundle */");
+  const std::string open = "<script type=\"application/json\" id=\"bimart-data\">";
+  const size_t begin = page.find(open) + open.size();
+  const nlohmann::json data = nlohmann::json::parse(page.substr(begin, page.find("</script>", begin) - begin));
+  ASSERT_EQ(data["samples"][0]["marks"].size(), 7u);
+  EXPECT_EQ(data["samples"][0]["marks"][4]["wrists"].size(), 5u);
+  EXPECT_EQ(data["samples"][0]["marks"][0]["region"]["part"], "top");
+  fs::remove_all(dir);
 }
 
 TEST(ViewerPage, ThreeHundredFramesStayUnderTenMegabytes) {

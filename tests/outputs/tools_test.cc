@@ -202,7 +202,14 @@ TEST(Chromium, ViewerPlaysOfflineAndShowsHandsAndObject) {
   std::string seqs;
   for (size_t i = 0; i < std::min<size_t>(2, in.ground_truth.size()); ++i) seqs += " " + in.ground_truth[i];
   const fs::path page = in.dir / "viewer.html";
-  const auto v = test::run_bimart("view" + seqs + " --measure-contacts --out " + page.string());
+  // Marks of a directed run: the left hand off the object early, the right wrist pinned above it.
+  const Sequence first = read_sequence(in.ground_truth.front());
+  const at::Tensor above = first.object_states[10].slice(0, 4, 7).to(at::kDouble) + at::tensor({0.0, 0.1, 0.0}, at::kDouble);
+  const fs::path hands = in.dir / "hands.yaml";
+  std::ofstream(hands) << "hands:\n  left:\n    - frames: [0, 5]\n      part: none\n  right:\n    - frame: 10\n      wrist: ["
+                       << above[0].item<double>() << ", " << above[1].item<double>() << ", " << above[2].item<double>()
+                       << "]\n";
+  const auto v = test::run_bimart("view" + seqs + " --measure-contacts --hands " + hands.string() + " --out " + page.string());
   ASSERT_EQ(v.status, 0) << v.output;
   std::printf("%s", v.output.c_str());
   const std::string shot = (fs::path(BIMART_TEST_WORK_DIR) / "viewer_screenshot.png").string();
@@ -211,6 +218,7 @@ TEST(Chromium, ViewerPlaysOfflineAndShowsHandsAndObject) {
   std::printf("%s", r.output.c_str());
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("console errors: 0, network requests: 0"), std::string::npos);
+  EXPECT_NE(r.output.find("marks at pinned frame 10: {\"marks\":2,\"pins\":1"), std::string::npos);
   EXPECT_GT(fs::file_size(shot), 10000u);
 }
 

@@ -2,8 +2,8 @@
 //   node viewer_check.js PAGE.html SCREENSHOT.png [CHROMIUM]
 // no console errors or page errors, no request other than the page itself (data: and
 // blob: URLs are in-page), the frame counter advances while playing, the sample switcher
-// works, and a flat-colour pass shows both hands and the object (pixel counts). Then a
-// screenshot. Exits 1 on any failure.
+// works, and a flat-colour pass shows both hands and the object (pixel counts); with marks of
+// a directed run, a pinned frame shows its pin and a free frame none. Then a screenshot. Exits 1 on any failure.
 const path = require('path');
 const puppeteer = require('puppeteer-core');
 
@@ -53,6 +53,30 @@ async function main() {
     const hidden = await page.evaluate(() => window.bimartViewer.coverage());
     await page.click('#show-left');
     if (hidden.left !== 0) failures.push(`left hand toggled off still covers ${hidden.left} pixels`);
+    // A directed run's marks (bimart view --hands): at a pinned frame the pin is shown and
+    // named under the timeline; at a frame no mark covers, nothing is.
+    const marks = await page.evaluate(() => JSON.parse(document.getElementById('bimart-data').textContent).samples[0].marks || []);
+    if (marks.length) {
+      const pin = marks.find((m) => m.wrists);
+      const covered = (f) => marks.some((m) => f >= m.first && f <= m.last);
+      const frames = await page.evaluate(() => JSON.parse(document.getElementById('bimart-data').textContent).samples[0].frames);
+      let free = -1;
+      for (let f = 0; f < frames && free < 0; ++f) if (!covered(f)) free = f;
+      if (free >= 0) {
+        await page.evaluate((f) => window.bimartViewer.setFrame(f), free);
+        const at = await page.evaluate(() => window.bimartViewer.marksShown());
+        console.log(`marks at free frame ${free}: ${JSON.stringify(at)}`);
+        if (at.pins !== 0 || !/free/.test(at.text)) failures.push('a frame without marks shows ' + JSON.stringify(at));
+      }
+      if (pin) {
+        await page.evaluate((f) => window.bimartViewer.setFrame(f), pin.first);
+        const at = await page.evaluate(() => window.bimartViewer.marksShown());
+        console.log(`marks at pinned frame ${pin.first}: ${JSON.stringify(at)}`);
+        if (at.pins < 1 || !at.text.includes(pin.label)) failures.push('the pinned frame shows ' + JSON.stringify(at));
+      }
+      const strip = await page.$eval('#marks', (e) => !e.hidden && e.getBoundingClientRect().height > 20);
+      if (!strip) failures.push('the timeline of marks is not shown');
+    }
     await new Promise((r) => setTimeout(r, 200));
     await page.screenshot({ path: shot });
     console.log(`console errors: ${errors.length}, network requests: ${requests.length}, screenshot ${shot}`);

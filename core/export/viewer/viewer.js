@@ -7,6 +7,12 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
 const CONTACT_COLORS = [new THREE.Color(0.9, 0.05, 0.05), new THREE.Color(0.55, 0.05, 0.85)];  // left, right
 
+// Timeline colours of the marks of a directed run (core/export/viewer_marks.h): the parts'
+// colours of the scene, grey for "any", dark for "off the object", the hands' for pins.
+const MARK_COLORS = { top: '#f28c33', bottom: '#4d80d9', any: '#9a9a9a', none: '#333333', redraw: '#2ca02c',
+                      contacts: '#a8d5a8' };
+const HAND_CSS = ['#e60d0d', '#8c0dd9'];
+
 function decodeBase64(s) {
   const bin = atob(s);
   const out = new Uint8Array(bin.length);
@@ -49,6 +55,28 @@ function prepareContacts(part) {
   part.material.needsUpdate = true;
 }
 
+// Scene markers of a sample's marks: per hand a sphere at the pinned wrist (shown at the
+// pinned frames, through the hand), per region a wire sphere on its part (moves with it).
+function makeMarkers(marks, parts, scene) {
+  const pins = [0, 1].map((h) => {
+    const m = new THREE.Mesh(new THREE.SphereGeometry(0.012, 16, 12),
+      new THREE.MeshBasicMaterial({ color: HAND_CSS[h], transparent: true, opacity: 0.55, depthTest: false }));
+    m.renderOrder = 10; m.visible = false; scene.add(m);
+    return m;
+  });
+  const regions = [];
+  for (const mk of marks) {
+    if (!mk.region) continue;
+    const part = mk.region.part === 'top' ? parts.top : parts.bottom;
+    if (!part) continue;
+    const m = new THREE.Mesh(new THREE.SphereGeometry(mk.region.radius, 20, 14),
+      new THREE.MeshBasicMaterial({ color: HAND_CSS[mk.hand], wireframe: true, transparent: true, opacity: 0.6 }));
+    m.position.set(...mk.region.point); m.visible = false; part.add(m);
+    regions.push({ mark: mk, mesh: m });
+  }
+  return { pins, regions };
+}
+
 async function main() {
   const data = JSON.parse(document.getElementById('bimart-data').textContent);
   const canvas = document.getElementById('view');
@@ -74,7 +102,7 @@ async function main() {
     if (s.contacts) { prepareContacts(parts.top); prepareContacts(parts.bottom); }
     root.visible = false;
     scene.add(root);
-    samples.push({ info: s, root, mixer, parts });
+    samples.push({ info: s, root, mixer, parts, markers: makeMarkers(s.marks || [], parts, scene) });
   }
 
   const ui = {
@@ -83,6 +111,8 @@ async function main() {
     frame: document.getElementById('frame'), left: document.getElementById('show-left'),
     right: document.getElementById('show-right'), object: document.getElementById('show-object'),
     contacts: document.getElementById('show-contacts'), status: document.getElementById('status'),
+    marks: document.getElementById('marks'), timeline: document.getElementById('timeline'),
+    now: document.getElementById('now'),
   };
   samples.forEach((s, i) => ui.sample.add(new Option(s.info.name, String(i))));
 
@@ -109,11 +139,47 @@ async function main() {
     top.needsUpdate = true; bottom.needsUpdate = true;
   }
 
+  // The marks at frame f: the line under the timeline, the pinned wrists, the regions.
+  function applyMarks(s, f) {
+    const marks = s.info.marks || [];
+    const here = marks.filter((m) => f >= m.first && f <= m.last);
+    ui.now.textContent = marks.length ? (here.length ? here.map((m) => m.label).join(' · ') : 'frame ' + f + ': free') : '';
+    s.markers.pins.forEach((p) => { p.visible = false; });
+    for (const m of here)
+      if (m.wrists) { const p = s.markers.pins[m.hand]; p.position.set(...m.wrists[f - m.first]); p.visible = true; }
+    for (const r of s.markers.regions) r.mesh.visible = f >= r.mark.first && f <= r.mark.last;
+    drawTimeline(s, f);
+  }
+
+  // Two rows (left, right) over the frames; a redrawn stretch spans both; pins are ticks.
+  function drawTimeline(s, f) {
+    const marks = s.info.marks || [];
+    if (!marks.length) return;
+    const c = ui.timeline, dpr = window.devicePixelRatio || 1;
+    const w = c.clientWidth, h = c.clientHeight;
+    if (c.width !== Math.round(w * dpr)) { c.width = Math.round(w * dpr); c.height = Math.round(h * dpr); }
+    const g = c.getContext('2d');
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    g.clearRect(0, 0, w, h);
+    g.fillStyle = '#eee'; g.fillRect(0, 0, w, h);
+    const n = frames(), x = (k) => (k / n) * w, row = h / 2;
+    const order = ['contacts', 'redraw', 'top', 'bottom', 'any', 'none', 'wrist', 'pose'];
+    for (const m of [...marks].sort((a, b) => order.indexOf(a.kind) - order.indexOf(b.kind))) {
+      const pin = m.kind === 'wrist' || m.kind === 'pose';
+      g.fillStyle = pin ? HAND_CSS[m.hand] : MARK_COLORS[m.kind];
+      const x0 = x(m.first), x1 = Math.max(x(m.last + 1), x0 + (pin ? 3 : 1));
+      if (m.hand < 0) g.fillRect(x0, 0, x1 - x0, h);
+      else if (pin) g.fillRect(x0, m.hand * row, x1 - x0, row - 1);
+      else g.fillRect(x0, m.hand * row + 1, x1 - x0, row - 3);
+    }
+    g.fillStyle = '#000'; g.fillRect(x(f + 0.5) - 1, 0, 2, h);
+  }
+
   function setFrame(f) {
     const s = cur();
     f = Math.max(0, Math.min(frames() - 1, f));
     s.mixer.setTime(f / fps());
-    if (f !== frame) { frame = f; framesShown += 1; applyContacts(s, f); }
+    if (f !== frame) { frame = f; framesShown += 1; applyContacts(s, f); applyMarks(s, f); }
     ui.slider.value = String(f);
     ui.frame.textContent = `frame ${f} / ${frames() - 1}`;
   }
@@ -121,6 +187,7 @@ async function main() {
   function visibility() {
     for (const s of samples) {
       s.root.visible = s === cur();
+      if (s !== cur()) s.markers.pins.forEach((p) => { p.visible = false; });
       for (const m of s.parts.left) m.visible = ui.left.checked;
       for (const m of s.parts.right) m.visible = ui.right.checked;
       if (s.parts.object) s.parts.object.visible = ui.object.checked;
@@ -152,6 +219,13 @@ async function main() {
     frame = -1;
     setFrame(Math.min(Math.round(time * fps()), frames() - 1));
     ui.contacts.disabled = !cur().info.contacts;
+    const directed = (cur().info.marks || []).length > 0;
+    ui.marks.hidden = !directed;
+    document.body.classList.toggle('directed', directed);
+    if (directed) { ui.timeline.title = 'left hand above, right hand below: ' +
+      'orange on the top part, blue on the bottom part, grey anywhere, dark off the object, ' +
+      'red/purple ticks pinned wrists or poses, green the stretch drawn anew; click to go to a frame';
+      applyMarks(cur(), frame); }
   }
 
   ui.play.addEventListener('click', () => { playing = !playing; ui.play.textContent = playing ? 'Pause' : 'Play'; });
@@ -159,6 +233,10 @@ async function main() {
   ui.sample.addEventListener('change', () => selectSample(Number(ui.sample.value)));
   for (const box of [ui.left, ui.right, ui.object]) box.addEventListener('change', visibility);
   ui.contacts.addEventListener('change', () => applyContacts(cur(), frame));
+  ui.timeline.addEventListener('click', (e) => {
+    const f = Math.floor((e.offsetX / ui.timeline.clientWidth) * frames());
+    playing = false; ui.play.textContent = 'Play'; time = f / fps(); setFrame(f);
+  });
 
   function resize() {
     const w = canvas.clientWidth, h = canvas.clientHeight;
@@ -220,6 +298,9 @@ async function main() {
     ready: true, samples: samples.length, frame: () => frame, framesShown: () => framesShown,
     setFrame: (f) => { time = f / fps(); setFrame(f); }, play: (on) => { playing = on; }, coverage,
     select: (i) => { ui.sample.value = String(i); selectSample(i); },
+    // What the marks show now: pinned wrists and regions visible, and the line of text.
+    marksShown: () => ({ marks: (cur().info.marks || []).length, pins: cur().markers.pins.filter((p) => p.visible).length,
+                         regions: cur().markers.regions.filter((r) => r.mesh.visible).length, text: ui.now.textContent }),
   };
   ui.status.textContent = '';
 }
