@@ -1,15 +1,21 @@
-// `bimart edit SAMPLE.npz --frames A:B`: an earlier sample with a stretch redrawn
-// (docs/directing.md). Runs a pipeline (the default one unless --pipeline) on the sample
+// Directing commands (docs/directing.md). `bimart edit SAMPLE.npz --frames A:B`: an earlier
+// sample with a stretch redrawn. Runs a pipeline (the default one unless --pipeline) on the sample
 // itself as the trajectory, with `trajectory.redraw` set: the frames outside A..B come out
-// exactly as they were, the stretch is sampled anew and joined to them.
+// exactly as they were, the stretch is sampled anew and joined to them. `bimart constraints
+// SAMPLES --hands FILE`: how well each constraint of FILE holds in each sample.
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <iostream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "core/cli/command.h"
 #include "core/cli/common_options.h"
 #include "core/cli/pipeline_commands.h"
+#include "core/directing/constraint_report.h"
+#include "core/export/scene_source.h"
 #include "core/util/data_path.h"
 #include "core/util/error.h"
 
@@ -62,9 +68,50 @@ int edit(const EditArgs& e) {
   return run(pa);
 }
 
+struct ConstraintsArgs {
+  std::vector<std::string> samples;
+  std::string hands, mano_left, mano_right;
+  bool json = false;
+};
+
+// Exit 0 when every constraint holds in every sample, 1 when one does not (the report says which).
+int report_constraints(const ConstraintsArgs& a) {
+  const auto models = load_export_hands(a.mano_left, a.mano_right);
+  nlohmann::json all = nlohmann::json::array();
+  bool every = true;
+  for (const std::string& path : a.samples) {
+    const SceneSource src = load_scene_source(path, models);
+    const std::vector<ConstraintCheck> checks = check_constraints(read_hand_constraints_for_sample(a.hands, path), src);
+    nlohmann::json js = nlohmann::json::array();
+    if (!a.json) std::cout << path << "\n";
+    for (const ConstraintCheck& c : checks) {
+      every = every && c.holds;
+      if (a.json)
+        js.push_back({{"asked", c.asked}, {"measured", c.measured}, {"value", c.value}, {"holds", c.holds}});
+      else
+        std::cout << fmt::format("  {} {}: {}\n", c.holds ? "holds " : "MISSED", c.asked, c.measured);
+    }
+    all.push_back({{"sample", path}, {"constraints", js}});
+  }
+  if (a.json) std::cout << all.dump(2) << "\n";
+  return every ? 0 : 1;
+}
+
 }  // namespace
 
 void add_edit_commands(CLI::App& app, Commands& out) {
+  {
+    static ConstraintsArgs c;
+    CLI::App* cmd = app.add_subcommand("constraints", "how well each hand constraint holds in samples (docs/directing.md)");
+    cmd->add_option("samples", c.samples, "sequence files (sample_K.npz of bimart run)")->required()->check(CLI::ExistingFile);
+    cmd->add_option("--hands", c.hands, "the trajectory file (or a file with a `hands:` block) the samples were made with")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_flag("--json", c.json, "print the report as JSON");
+    cmd->add_option("--mano-left", c.mano_left, "left hand model .npz the samples were made with (default: the shipped hand)");
+    cmd->add_option("--mano-right", c.mano_right, "right hand model .npz (give both or neither)");
+    out.push_back({cmd, [] { return report_constraints(c); }, false});
+  }
   static EditArgs e;
   CLI::App* cmd = app.add_subcommand("edit", "redraw a stretch of an earlier sample, keeping every other frame (docs/directing.md)");
   cmd->add_option("sample", e.sample, "the sample's sequence file (sample_K.npz of bimart run)")

@@ -12,7 +12,6 @@
 #include "core/export/scene_picture.h"
 #include "core/export/scene_source.h"
 #include "core/export/viewer_page.h"
-#include "core/trajectory/trajectory.h"
 #include "core/util/error.h"
 #include "core/util/atomic_file.h"
 
@@ -72,19 +71,6 @@ int run_export(const ExportOptions& o) {
   return 0;
 }
 
-// The constraints of `file` (a trajectory file with a `hands:` block, or a file with only
-// the block) on the sample `s`: `t:` on the file's clock when it is a trajectory, else on
-// the sample's.
-HandConstraints constraints_for(const std::string& file, const SceneSource& s) {
-  Trajectory clock;
-  try {
-    clock = read_trajectory(file, s.sequence.fps);
-  } catch (const Error&) {
-    clock = read_trajectory(s.path);
-  }
-  return read_hand_constraints(file, clock, true);
-}
-
 int run_view(const ExportOptions& o) {
   viewer_bundle_path();  // before any work
   const auto sources = load_all(o);
@@ -98,7 +84,7 @@ int run_view(const ExportOptions& o) {
     v.contacts = viewer_contacts(s.sequence);
     if (v.contacts.empty() && o.measure_contacts) v.contacts = measured_contacts(s);
     v.top_vertices = s.object.top.num_vertices();
-    if (!o.hands.empty()) v.marks = viewer_marks(constraints_for(o.hands, s), s);
+    if (!o.hands.empty()) v.marks = viewer_marks(read_hand_constraints_for_sample(o.hands, s.path), s);
     samples.push_back(std::move(v));
   }
   const std::string title = o.title.empty() ? "bimart: " + samples.front().name : o.title;

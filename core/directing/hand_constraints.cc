@@ -30,8 +30,10 @@ double ContactConstraint::clearance_at(std::int64_t frame) const {
   if (part != ContactPart::None) return 0;
   const std::int64_t outside = std::max(frames.first - frame, frame - frames.last);  // > 0 on a ramp
   if (outside <= 0) return clearance;
-  if (outside > ramp) return 0;
-  return clearance * 0.5 * (1 + std::cos(M_PI * static_cast<double>(outside) / (ramp + 1)));
+  const int cut = frame < frames.first ? ramp_before : ramp_after;
+  const int side = cut < 0 ? ramp : std::min(cut, ramp);
+  if (outside > side) return 0;
+  return clearance * 0.5 * (1 + std::cos(M_PI * static_cast<double>(outside) / (side + 1)));
 }
 
 namespace {
@@ -160,6 +162,22 @@ struct Parser : YamlReader {
   }
 };
 
+// The ramps of `none` constraints cut to the frames between them and the hand's other
+// contact constraints: a hand asked to touch until frame 60 is not pushed off before it.
+void fit_ramps(std::vector<ContactConstraint>& contacts) {
+  for (ContactConstraint& c : contacts) {
+    if (c.part != ContactPart::None) continue;
+    c.ramp_before = c.ramp_after = c.ramp;
+    for (const ContactConstraint& o : contacts) {
+      if (&o == &c || o.hand != c.hand) continue;
+      if (o.frames.last < c.frames.first)
+        c.ramp_before = static_cast<int>(std::min<std::int64_t>(c.ramp_before, c.frames.first - o.frames.last - 1));
+      if (o.frames.first > c.frames.last)
+        c.ramp_after = static_cast<int>(std::min<std::int64_t>(c.ramp_after, o.frames.first - c.frames.last - 1));
+    }
+  }
+}
+
 template <class T>
 void check_overlaps(const std::vector<T>& list, const char* what) {
   for (std::size_t i = 0; i < list.size(); ++i)
@@ -187,6 +205,7 @@ HandConstraints parse_node(const YAML::Node& hands, const Parser& p) {
   }
   check_overlaps(out.contacts, "a contact constraint");
   check_overlaps(out.pins, "a pin");
+  fit_ramps(out.contacts);
   return out;
 }
 
@@ -279,6 +298,16 @@ Eigen::Isometry3d object_pose_at(const at::Tensor& states, std::int64_t frame) {
   return canonical_to_world(ObjectState::from_row(row.data_ptr<double>()));
 }
 
+HandConstraints read_hand_constraints_for_sample(const std::string& file, const std::string& sample_path) {
+  Trajectory clock;
+  try {
+    clock = read_trajectory(file, read_sequence(sample_path).fps);
+  } catch (const Error&) {
+    clock = read_trajectory(sample_path);
+  }
+  return read_hand_constraints(file, clock, true);
+}
+
 PinnedPose read_pinned_pose(const HandPin& pin) {
   const Sequence seq = read_sequence(pin.source);
   const HandParams& p = seq.hands.hands[static_cast<std::size_t>(pin.hand)];
@@ -296,6 +325,7 @@ void merge_hand_constraints(HandConstraints& base, const HandConstraints& extra)
   base.pins.insert(base.pins.end(), extra.pins.begin(), extra.pins.end());
   check_overlaps(base.contacts, "a contact constraint");
   check_overlaps(base.pins, "a pin");
+  fit_ramps(base.contacts);
 }
 
 }  // namespace bimart

@@ -59,8 +59,11 @@ struct ContactConstraint {
   double clearance = 0.03;              // none: metres between the hand and the object
   SourceLocation where;
   // none: over this many frames before the range the clearance fades in and after it fades
-  // out (raised cosine), so the hand lets go and comes back smoothly.
+  // out (raised cosine), so the hand lets go and comes back smoothly. Each side is cut to
+  // the frames left free by the hand's other contact constraints (ramp_before, ramp_after;
+  // -1 = ramp), as the readers set them.
   int ramp = 8;
+  int ramp_before = -1, ramp_after = -1;
   // none: the clearance the hand keeps at `frame` (the full one inside the range, fading on
   // the ramps, 0 elsewhere); 0 for other parts.
   double clearance_at(std::int64_t frame) const;
@@ -109,6 +112,11 @@ struct HandConstraints {
 // of one hand on the same frame and a pin without wrist or pose are errors. `required`: a
 // file without the block is an error too (a file given only for its constraints).
 HandConstraints read_hand_constraints(const std::string& path, const Trajectory& trajectory, bool required = false);
+
+// The same for a sample made earlier (`bimart view --hands`, `bimart constraints`): the block
+// of `file` (the trajectory file the sample was made with, or a file with only the block),
+// `t:` on the file's clock when it is a trajectory, else on the sample's (`sample_path`).
+HandConstraints read_hand_constraints_for_sample(const std::string& file, const std::string& sample_path);
 
 // The same from YAML text (a `hands:` block's value, e.g. `{right: [{part: top}]}`), `label`
 // naming it in messages; relative sample paths are relative to `base_folder`.

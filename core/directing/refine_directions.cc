@@ -65,4 +65,12 @@ RefineDirections refine_directions(const HandConstraints& constraints, const std
   return r;
 }
 
+RefineDirections pinned_targets(std::vector<HandPin>& pins, const std::array<const HandModel*, 2>& hands,
+                                const at::Tensor& states) {
+  HandConstraints only;
+  for (HandPin& p : pins) p.frames.last = std::min(p.frames.last, states.size(0) - 1);
+  only.pins = pins;
+  return refine_directions(only, hands, states);
+}
+
 }  // namespace bimart

@@ -18,4 +18,10 @@ namespace bimart {
 RefineDirections refine_directions(const HandConstraints& constraints, const std::array<const HandModel*, 2>& hands,
                                    const at::Tensor& states);
 
+// The pins alone, cut to the frames of `states`, as the refinement pins them (per hand, per
+// frame: wrist, orientation, fingers): what a sample is measured against (viewer marks, the
+// constraint report). `pins` gets the cut ranges.
+RefineDirections pinned_targets(std::vector<HandPin>& pins, const std::array<const HandModel*, 2>& hands,
+                                const at::Tensor& states);
+
 }  // namespace bimart

@@ -59,11 +59,9 @@ std::vector<ViewerMark> viewer_marks(const HandConstraints& constraints, const S
   }
   if (!constraints.pins.empty()) {
     // The wrists as the refinement pins them: pose pins carried with the object to their frames.
-    HandConstraints pins_only;
-    pins_only.pins = constraints.pins;
-    for (HandPin& p : pins_only.pins) p.frames.last = std::min(p.frames.last, last_frame);
-    const RefineDirections r = refine_directions(pins_only, source.models(), source.sequence.object_states);
-    for (const HandPin& pin : pins_only.pins) {
+    std::vector<HandPin> pins = constraints.pins;
+    const RefineDirections r = pinned_targets(pins, source.models(), source.sequence.object_states);
+    for (const HandPin& pin : pins) {
       ViewerMark m;
       m.hand = pin.hand;
       clipped(pin.frames, m);

@@ -124,6 +124,18 @@ BENCHMARK(BM_DiffusionSampleWindow)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The right wrist pinned, with its orientation, at frames 32 and 63.
+void add_two_wrist_pins(HandConstraints& c) {
+  for (std::int64_t f : {32, 63}) {
+    HandPin pin;
+    pin.hand = 1;
+    pin.frames = {f, f};
+    pin.wrist = Eigen::Vector3d(0.05, 0.3, -0.1);
+    pin.rotation = Eigen::Quaterniond(axis_angle_to_matrix(Eigen::Vector3d(0, 1.2, 0)));
+    c.pins.push_back(pin);
+  }
+}
+
 // One 64-frame window of the shipped size (contact + motion, 1 sample, DDPM 50, guidance),
 // unconstrained (arg 0) or directed (arg 1): the right hand on the top part throughout, the
 // left hand kept off for 20 frames, the right wrist pinned (with its orientation) at two
@@ -144,14 +156,7 @@ void BM_DiffusionSampleWindowDirected(benchmark::State& state) {
   HandConstraints c;
   c.contacts.push_back({1, {0, 63}, ContactPart::Top, std::nullopt, 0.03, {}});
   c.contacts.push_back({0, {10, 29}, ContactPart::None, std::nullopt, 0.03, {}});
-  for (std::int64_t f : {32, 63}) {
-    HandPin pin;
-    pin.hand = 1;
-    pin.frames = {f, f};
-    pin.wrist = Eigen::Vector3d(0.05, 0.3, -0.1);
-    pin.rotation = Eigen::Quaterniond(axis_angle_to_matrix(Eigen::Vector3d(0, 1.2, 0)));
-    c.pins.push_back(pin);
-  }
+  add_two_wrist_pins(c);
   const ContactRules rules(c, object, hits);
   const HandPins pins(c, test::shipped_hands(), at::zeros({64, 7}, at::kDouble), points);
   GenerateOptions o;
@@ -172,16 +177,10 @@ void BM_HandPinsImpose(benchmark::State& state) {
   runtime::set_threads(2);
   const at::Tensor points = at::rand({64, 1024, 3}) * 0.2;
   HandConstraints c;
-  if (state.range(0) == 1) c.contacts.push_back({0, {10, 29}, ContactPart::None, std::nullopt, 0.03, {}});
-  for (std::int64_t f : {32, 63}) {
-    if (state.range(0) == 1) break;
-    HandPin pin;
-    pin.hand = 1;
-    pin.frames = {f, f};
-    pin.wrist = Eigen::Vector3d(0.05, 0.3, -0.1);
-    pin.rotation = Eigen::Quaterniond(axis_angle_to_matrix(Eigen::Vector3d(0, 1.2, 0)));
-    c.pins.push_back(pin);
-  }
+  if (state.range(0) == 1)
+    c.contacts.push_back({0, {10, 29}, ContactPart::None, std::nullopt, 0.03, {}});
+  else
+    add_two_wrist_pins(c);
   const HandPins pins(c, test::shipped_hands(), at::zeros({64, 7}, at::kDouble), points);
   const at::Tensor x0 = at::rand({1, 64, 1200}) * 0.2;
   for (auto _ : state) benchmark::DoNotOptimize(pins.impose(x0, 0, 10, 50));

@@ -18,6 +18,7 @@
 
 #include <ATen/ATen.h>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/hand/hand_model.h"
 #include "core/hand/lbs.h"
@@ -182,6 +183,16 @@ TEST_F(DirectedRuns, LeftNoneKeepsTheLeftHandThreeCentimetresOff) {
               1000 * closest, 1000 * closest_right, profile.c_str());
   EXPECT_GE(closest, 0.03 - 1e-4);
   EXPECT_LT(closest_right, kContactDistance) << "the right hand alone opens the lid: it touches the box";
+  // `bimart constraints` measures the same (per-vertex queries against frame_depths above).
+  const test::CliRun r = test::run_bimart("-q constraints " + (box_run() / "sample_0.npz").string() + " " +
+                                          (box_run() / "sample_1.npz").string() + " --hands " + kBoxLeftFree + " --json");
+  ASSERT_EQ(exit_code(r), 0) << r.output;
+  const auto report = nlohmann::json::parse(r.output.substr(r.output.find("[\n")));
+  double reported = 1e9;
+  for (const auto& sample : report)
+    for (const auto& c : sample["constraints"])
+      if (c["asked"].get<std::string>().rfind("left: at least 3 cm off", 0) == 0) reported = std::min(reported, c["value"].get<double>());
+  EXPECT_NEAR(reported, closest, 1e-6);
 }
 
 TEST_F(DirectedRuns, PinnedWristIsAtItsPinAfterTheRefinement) {

@@ -78,6 +78,15 @@ TEST(HandConstraints, ReadsTheBlockOfATrajectoryFile) {
   EXPECT_EQ(c.contacts[1].clearance_at(25), 0.0);
   EXPECT_EQ(c.contacts[1].clearance_at(65), 0.0);
   EXPECT_EQ(c.contacts[0].clearance_at(10), 0.0);  // not a `none` constraint
+  // A ramp is cut to the frames left free by the hand's other contact constraints.
+  const std::string cut = write_file("cut.yaml", "keys: []\nhands:\n  right:\n    - frames: [0, 40]\n      part: top\n"
+                                                 "    - frames: [44, 60]\n      part: none\n");
+  const ContactConstraint& off = read_hand_constraints(cut, trajectory_of()).contacts.at(1);
+  EXPECT_EQ(off.ramp_before, 3);
+  EXPECT_EQ(off.clearance_at(40), 0.0);
+  EXPECT_GT(off.clearance_at(41), 0.0);
+  EXPECT_GT(off.clearance_at(68), 0.0);  // after the range: the full 8 frames
+  EXPECT_EQ(off.clearance_at(69), 0.0);
   EXPECT_EQ(c.contacts[2].hand + c.contacts[3].hand, 1);  // both: one each
   ASSERT_EQ(c.pins.size(), 1u);
   EXPECT_EQ(c.pins[0].frames.first, 70);
