@@ -120,6 +120,9 @@ async function main() {
   const cur = () => samples[current];
   const frames = () => cur().info.frames;
   const fps = () => cur().info.fps;
+  // The clip's time of frame f. The clip lasts (frames - 1) / fps and loops, so the last
+  // frame's own time would wrap to frame 0: it is taken a microsecond earlier.
+  const clipTime = (f) => Math.min(f, frames() - 1) / fps() - (f >= frames() - 1 ? 1e-6 : 0);
 
   function applyContacts(s, f) {
     const c = s.info.contacts;
@@ -178,7 +181,7 @@ async function main() {
   function setFrame(f) {
     const s = cur();
     f = Math.max(0, Math.min(frames() - 1, f));
-    s.mixer.setTime(f / fps());
+    s.mixer.setTime(clipTime(f));
     if (f !== frame) { frame = f; framesShown += 1; applyContacts(s, f); applyMarks(s, f); }
     ui.slider.value = String(f);
     ui.frame.textContent = `frame ${f} / ${frames() - 1}`;
@@ -199,7 +202,7 @@ async function main() {
     const s = cur();
     const box = new THREE.Box3();
     for (const u of [0, 0.25, 0.5, 0.75, 1]) {
-      s.mixer.setTime(u * (frames() - 1) / fps());
+      s.mixer.setTime(clipTime(u * (frames() - 1)));
       s.root.updateMatrixWorld(true);
       box.union(new THREE.Box3().setFromObject(s.root, true));
     }
@@ -209,7 +212,7 @@ async function main() {
     camera.position.copy(centre).add(new THREE.Vector3(0.35, 0.6, 1.0).normalize().multiplyScalar(dist));
     camera.near = dist / 100; camera.far = dist * 10; camera.updateProjectionMatrix();
     controls.target.copy(centre); controls.update();
-    s.mixer.setTime(Math.max(0, frame) / fps());
+    s.mixer.setTime(clipTime(Math.max(0, frame)));
   }
 
   function selectSample(i) {
