@@ -81,7 +81,7 @@ int report_constraints(const ConstraintsArgs& a) {
   bool every = true;
   for (const std::string& path : a.samples) {
     const SceneSource src = load_scene_source(path, models);
-    const std::vector<ConstraintCheck> checks = check_constraints(read_hand_constraints_for_sample(a.hands, path), src);
+    const std::vector<ConstraintCheck> checks = check_constraints(read_hand_constraints_for_sample(a.hands, path, src.sequence.fps), src);
     nlohmann::json js = nlohmann::json::array();
     if (!a.json) std::cout << path << "\n";
     for (const ConstraintCheck& c : checks) {

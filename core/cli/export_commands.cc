@@ -84,7 +84,7 @@ int run_view(const ExportOptions& o) {
     v.contacts = viewer_contacts(s.sequence);
     if (v.contacts.empty() && o.measure_contacts) v.contacts = measured_contacts(s);
     v.top_vertices = s.object.top.num_vertices();
-    if (!o.hands.empty()) v.marks = viewer_marks(read_hand_constraints_for_sample(o.hands, s.path), s);
+    if (!o.hands.empty()) v.marks = viewer_marks(read_hand_constraints_for_sample(o.hands, s.path, s.sequence.fps), s);
     samples.push_back(std::move(v));
   }
   const std::string title = o.title.empty() ? "bimart: " + samples.front().name : o.title;

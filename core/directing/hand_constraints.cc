@@ -31,9 +31,13 @@ double ContactConstraint::clearance_at(std::int64_t frame) const {
   const std::int64_t outside = std::max(frames.first - frame, frame - frames.last);  // > 0 on a ramp
   if (outside <= 0) return clearance;
   const int cut = frame < frames.first ? ramp_before : ramp_after;
-  const int side = cut < 0 ? ramp : std::min(cut, ramp);
+  const int side = cut < 0 ? ramp : cut;
   if (outside > side) return 0;
   return clearance * 0.5 * (1 + std::cos(M_PI * static_cast<double>(outside) / (side + 1)));
+}
+
+FrameRange ContactConstraint::with_ramps(std::int64_t n) const {
+  return {std::max<std::int64_t>(0, frames.first - ramp), std::min(frames.last + ramp, n - 1)};
 }
 
 namespace {
@@ -298,10 +302,10 @@ Eigen::Isometry3d object_pose_at(const at::Tensor& states, std::int64_t frame) {
   return canonical_to_world(ObjectState::from_row(row.data_ptr<double>()));
 }
 
-HandConstraints read_hand_constraints_for_sample(const std::string& file, const std::string& sample_path) {
+HandConstraints read_hand_constraints_for_sample(const std::string& file, const std::string& sample_path, double fps) {
   Trajectory clock;
   try {
-    clock = read_trajectory(file, read_sequence(sample_path).fps);
+    clock = read_trajectory(file, fps);
   } catch (const Error&) {
     clock = read_trajectory(sample_path);
   }

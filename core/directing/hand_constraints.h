@@ -67,6 +67,8 @@ struct ContactConstraint {
   // none: the clearance the hand keeps at `frame` (the full one inside the range, fading on
   // the ramps, 0 elsewhere); 0 for other parts.
   double clearance_at(std::int64_t frame) const;
+  // The frames the range and its ramps cover, cut to [0, frames).
+  FrameRange with_ramps(std::int64_t frames) const;
 };
 
 // A hand held at chosen frames: its wrist (MANO's root joint) at `wrist` (world frame, m),
@@ -116,7 +118,8 @@ HandConstraints read_hand_constraints(const std::string& path, const Trajectory&
 // The same for a sample made earlier (`bimart view --hands`, `bimart constraints`): the block
 // of `file` (the trajectory file the sample was made with, or a file with only the block),
 // `t:` on the file's clock when it is a trajectory, else on the sample's (`sample_path`).
-HandConstraints read_hand_constraints_for_sample(const std::string& file, const std::string& sample_path);
+// `fps`: the sample's frame rate.
+HandConstraints read_hand_constraints_for_sample(const std::string& file, const std::string& sample_path, double fps);
 
 // The same from YAML text (a `hands:` block's value, e.g. `{right: [{part: top}]}`), `label`
 // naming it in messages; relative sample paths are relative to `base_folder`.

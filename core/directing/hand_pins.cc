@@ -79,7 +79,8 @@ HandPins::HandPins(const HandConstraints& constraints, const std::array<const Ha
       if (c.frames.last >= N)
         throw Error(c.where, fmt::format("frames up to {}, but the trajectory has {} frames", c.frames.last, N));
       away_.push_back(c);
-      for (std::int64_t f = std::max<std::int64_t>(0, c.frames.first - c.ramp); f <= std::min(c.frames.last + c.ramp, N - 1); ++f) {
+      const FrameRange span = c.with_ramps(N);
+      for (std::int64_t f = span.first; f <= span.last; ++f) {
         if (trees_.count(f)) continue;
         const at::Tensor pd = points_[f].to(at::kDouble).contiguous();
         Points3 pts = Eigen::Map<const Points3>(pd.data_ptr<double>(), pd.size(0), 3);
@@ -200,8 +201,8 @@ at::Tensor HandPins::impose(const at::Tensor& x0, std::int64_t first, int /*step
   Hn = Hn.contiguous();
   float* const hp = Hn.data_ptr<float>();
   for (const ContactConstraint& a : away_) {
-    const std::int64_t s0 = std::max(a.frames.first - a.ramp - first, std::int64_t{0}),
-                       s1 = std::min(a.frames.last + a.ramp - first + 1, T);
+    const FrameRange span = a.with_ramps(first + T);
+    const std::int64_t s0 = std::max(span.first - first, std::int64_t{0}), s1 = span.last - first + 1;
     if (s0 >= s1) continue;
     // Frames (and samples) are independent: spread over the cores.
     at::parallel_for(0, (s1 - s0) * B, 1, [&](std::int64_t begin, std::int64_t end) {

@@ -38,7 +38,8 @@ RefineDirections refine_directions(const HandConstraints& constraints, const std
     if (c.part != ContactPart::None) continue;
     auto& clear = r.clearance[static_cast<std::size_t>(c.hand)];
     if (clear.empty()) clear.assign(static_cast<std::size_t>(N), 0.0);
-    for (std::int64_t f = std::max<std::int64_t>(0, c.frames.first - c.ramp); f <= std::min(c.frames.last + c.ramp, N - 1); ++f)
+    const FrameRange span = c.with_ramps(N);
+    for (std::int64_t f = span.first; f <= span.last; ++f)
       clear[static_cast<std::size_t>(f)] = std::max(clear[static_cast<std::size_t>(f)], c.clearance_at(f));
   }
   if (!constraints.contacts.empty()) std::tie(r.may_hold, r.may_hold_top) = hands_that_may_hold(constraints, N);
