@@ -14,25 +14,22 @@
 namespace bimart {
 namespace {
 
-at::Tensor rows_of(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& m, const std::vector<int>& ids) {
-  at::Tensor out = at::empty({static_cast<std::int64_t>(ids.size()), 3}, at::kDouble);
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    for (int c = 0; c < 3; ++c) out[static_cast<std::int64_t>(i)][c] = m(ids[i], c);
+Points3 rows_of(const Points3& m, const std::vector<int>& ids) {
+  Points3 out(static_cast<Eigen::Index>(ids.size()), 3);
+  for (std::size_t i = 0; i < ids.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(ids[i]);
   return out;
 }
 
 // Keypoints [J, 3] of a pose pin's hand at its source frame, in the object's canonical
-// frame there (float32).
-at::Tensor source_keypoints(const HandModel& model, const HandPin& pin) {
+// frame there.
+HandPins::Keys source_keypoints(const HandModel& model, const HandPin& pin) {
   const PinnedPose src = read_pinned_pose(pin);
   const LbsResult<double> r = lbs<double>(model, src.rot, src.pose, src.trans, src.shape);
   const Eigen::Isometry3d to_canonical = src.object.inverse();
   const std::vector<int> ids = model_keypoints(model);
-  at::Tensor k = at::empty({static_cast<std::int64_t>(ids.size()), 3}, at::kFloat);
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    const Eigen::Vector3d c = to_canonical * Eigen::Vector3d(r.vertices.row(ids[i]).transpose());
-    for (int a = 0; a < 3; ++a) k[static_cast<std::int64_t>(i)][a] = c[a];
-  }
+  HandPins::Keys k(static_cast<Eigen::Index>(ids.size()), 3);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    k.row(static_cast<Eigen::Index>(i)) = (to_canonical * Eigen::Vector3d(r.vertices.row(ids[i]).transpose())).cast<float>().transpose();
   return k;
 }
 
@@ -55,12 +52,12 @@ HandPins::HandPins(const HandConstraints& constraints, const std::array<const Ha
     Palm& p = palms_[static_cast<std::size_t>(h)];
     p.rest = rows_of(rest.vertices, palm_ids);
     p.wrist = rest.joints.row(0).transpose();
-    p.index = at::tensor(std::vector<std::int64_t>(palm_rows.begin(), palm_rows.end()), at::kLong);
+    p.index = palm_rows;
   }
   for (const HandPin& pin : constraints.pins) {
     if (pin.frames.last >= N)
       throw Error(pin.where, fmt::format("frames up to {}, but the trajectory has {} frames", pin.frames.last, N));
-    at::Tensor pose;
+    Keys pose;
     if (pin.whole_pose())
       pose = source_keypoints(*hands[static_cast<std::size_t>(pin.hand)], pin);
     for (std::int64_t f = pin.frames.first; f <= pin.frames.last; ++f) {
@@ -90,12 +87,12 @@ HandPins::HandPins(const HandConstraints& constraints, const std::array<const Ha
     }
 }
 
-std::pair<Eigen::Matrix3d, Eigen::Vector3d> HandPins::fit_palm(const at::Tensor& keypoints, int hand) const {
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> HandPins::fit_palm(const Eigen::Ref<const Keys>& keypoints, int hand) const {
   const Palm& palm = palms_[static_cast<std::size_t>(hand)];
-  const at::Tensor P = keypoints.to(at::kDouble).index_select(0, palm.index).contiguous();  // current
-  const at::Tensor Q = palm.rest;                                                            // rest
-  using Rows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-  const Eigen::Map<const Rows> p(P.data_ptr<double>(), P.size(0), 3), q(Q.data_ptr<double>(), Q.size(0), 3);
+  Points3 p(static_cast<Eigen::Index>(palm.index.size()), 3);  // current
+  for (std::size_t i = 0; i < palm.index.size(); ++i)
+    p.row(static_cast<Eigen::Index>(i)) = keypoints.row(palm.index[i]).cast<double>();
+  const Points3& q = palm.rest;
   const Eigen::RowVector3d pc = p.colwise().mean(), qc = q.colwise().mean();
   // Kabsch: R minimising |R (q - qc) - (p - pc)|, a proper rotation.
   const Eigen::Matrix3d cov = (q.rowwise() - qc).transpose() * (p.rowwise() - pc);
@@ -108,7 +105,8 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> HandPins::fit_palm(const at::Tensor&
 
 std::pair<Eigen::Vector3d, Eigen::Matrix3d> HandPins::wrist_of(const at::Tensor& keypoints, int hand,
                                                                std::int64_t frame) const {
-  const auto [R, w] = fit_palm(keypoints, hand);
+  const at::Tensor k = keypoints.to(at::kFloat).contiguous();
+  const auto [R, w] = fit_palm(Eigen::Map<const Keys>(k.data_ptr<float>(), k.size(0), 3), hand);
   const Eigen::Isometry3d to_world = object_pose_at(states_, frame);
   return {to_world * w, to_world.linear() * R};
 }
@@ -122,14 +120,18 @@ namespace {
 double clearing_shift(const Points3& keys, const Eigen::Vector3d& d, const NearestPoints& tree,
                       double need) {
   // A hand whose keypoints' bounding ball is clear of the nearest point needs nothing.
+  // So is, at each α, every keypoint closer to the centre than the centre's distance to the
+  // object minus `need` (triangle inequality): only the others ask the k-d tree.
   const Eigen::Vector3d centre = keys.colwise().mean().transpose();
-  const double reach = (keys.rowwise() - centre.transpose()).rowwise().norm().maxCoeff();
-  if (std::sqrt(tree.nearest(centre).distance_sq) >= reach + need) return 0;
+  const Eigen::VectorXd from_centre = (keys.rowwise() - centre.transpose()).rowwise().norm();
+  if (std::sqrt(tree.nearest(centre).distance_sq) >= from_centre.maxCoeff() + need) return 0;
   double alpha = 0;
   std::vector<int> hits;
   for (int step = 0; step < 1000; ++step) {
     double next = alpha;
+    const double clear_within = std::sqrt(tree.nearest(centre + alpha * d).distance_sq) - need;
     for (Eigen::Index j = 0; j < keys.rows(); ++j) {
+      if (from_centre[j] <= clear_within) continue;
       const Eigen::Vector3d k = keys.row(j).transpose();
       tree.within(k + alpha * d, need, &hits);
       for (int i : hits) {
@@ -149,57 +151,64 @@ double clearing_shift(const Points3& keys, const Eigen::Vector3d& d, const Neare
 at::Tensor HandPins::impose(const at::Tensor& x0, std::int64_t first, int /*step*/, int /*num_steps*/) const {
   if (empty()) return x0;
   const std::int64_t B = x0.size(0), T = x0.size(1), J = kHandKeypoints;
-  const at::Tensor H = x0.slice(-1, 0, 600).to(at::kFloat).reshape({B, T, 2, J, 3});
-  // Each pinned frame's change [B, J, 3], exact there and spread around it.
-  at::Tensor spread = at::zeros({B, T, 2, J, 3}, at::kFloat), weight = at::zeros({T, 2}, at::kFloat);
-  at::Tensor exact = at::zeros({B, T, 2, J, 3}, at::kFloat), pinned = at::zeros({T, 2}, at::kBool);
-  const std::int64_t reach = static_cast<std::int64_t>(std::ceil(3 * sigma_));
-  for (const Target& tg : targets_) {
-    const std::int64_t t = tg.frame - first;
-    if (t < -reach || t >= T + reach) continue;
-    // The pin's change, measured on the frame itself when it is in the window, else on the
-    // window's nearest frame (its neighbours still run into it).
-    const std::int64_t at_t = std::clamp<std::int64_t>(t, 0, T - 1);
-    at::Tensor delta = at::empty({B, J, 3}, at::kFloat);
-    for (std::int64_t b = 0; b < B; ++b) {
-      const at::Tensor k = H[b][at_t][tg.hand];
-      at::Tensor target;
-      if (tg.keypoints.defined()) {
-        target = tg.keypoints;
-      } else {
-        const auto [R, w] = fit_palm(k, tg.hand);
-        const Eigen::Matrix3d turn = tg.turn ? Eigen::Matrix3d(tg.rotation * R.transpose()) : Eigen::Matrix3d::Identity();
-        at::Tensor Rt = at::empty({3, 3}, at::kDouble), wt = at::empty({3}, at::kDouble), pt = at::empty({3}, at::kDouble);
-        for (int r = 0; r < 3; ++r) {
-          wt[r] = w[r], pt[r] = tg.wrist[r];
-          for (int c = 0; c < 3; ++c) Rt[r][c] = turn(c, r);
+  const at::Tensor H = x0.slice(-1, 0, 600).to(at::kFloat).reshape({B, T, 2, J, 3}).contiguous();
+  at::Tensor Hn = H.clone();
+  const float* const h = H.data_ptr<float>();
+  float* const hp = Hn.data_ptr<float>();
+  const auto at_hand = [&](std::int64_t b, std::int64_t t, int hand) { return ((b * T + t) * 2 + hand) * J * 3; };
+  // Each pinned frame's change [J, 3] per sample, exact there and spread around it (plain
+  // loops over the buffers: a step's pins are a few hundred numbers, tensor ops cost more).
+  if (!targets_.empty()) {
+    std::vector<float> spread(static_cast<std::size_t>(B * T * 2 * J * 3), 0.0f), weight(static_cast<std::size_t>(T * 2), 0.0f);
+    std::vector<float> exact(spread.size(), 0.0f);
+    std::vector<char> pinned(weight.size(), 0);
+    const std::int64_t reach = static_cast<std::int64_t>(std::ceil(3 * sigma_));
+    Keys delta(J, 3);
+    for (const Target& tg : targets_) {
+      const std::int64_t t = tg.frame - first;
+      if (t < -reach || t >= T + reach) continue;
+      // The pin's change, measured on the frame itself when it is in the window, else on
+      // the window's nearest frame (its neighbours still run into it).
+      const std::int64_t at_t = std::clamp<std::int64_t>(t, 0, T - 1);
+      for (std::int64_t b = 0; b < B; ++b) {
+        const Eigen::Map<const Keys> k(h + at_hand(b, at_t, tg.hand), J, 3);
+        if (tg.keypoints.size() > 0) {
+          delta = tg.keypoints - k;
+        } else {
+          const auto [R, w] = fit_palm(k, tg.hand);
+          const Eigen::Matrix3d turn = tg.turn ? Eigen::Matrix3d(tg.rotation * R.transpose()) : Eigen::Matrix3d::Identity();
+          // Turned about the wrist, then the wrist onto the pin.
+          const Points3 target = ((k.cast<double>().rowwise() - w.transpose()) * turn.transpose()).rowwise() + tg.wrist.transpose();
+          delta = target.cast<float>() - k;
         }
-        target = (at::matmul(k.to(at::kDouble) - wt, Rt) + pt).to(at::kFloat);
+        if (t >= 0 && t < T) {
+          std::copy(delta.data(), delta.data() + J * 3, exact.begin() + at_hand(b, t, tg.hand));
+          pinned[static_cast<std::size_t>(t * 2 + tg.hand)] = 1;
+        }
+        if (sigma_ <= 0) continue;
+        for (std::int64_t s = std::max<std::int64_t>(0, t - reach); s < std::min(T, t + reach + 1); ++s) {
+          const float g = static_cast<float>(std::exp(-0.5 * std::pow(static_cast<double>(s - t) / sigma_, 2)));
+          float* out = spread.data() + at_hand(b, s, tg.hand);
+          for (std::int64_t i = 0; i < J * 3; ++i) out[i] += g * delta.data()[i];
+          if (b == 0) weight[static_cast<std::size_t>(s * 2 + tg.hand)] += g;
+        }
       }
-      delta[b] = target - k;
     }
-    if (t >= 0 && t < T) {
-      exact.select(1, t).select(1, tg.hand).copy_(delta);
-      pinned[t][tg.hand] = true;
-    }
-    if (sigma_ <= 0) continue;
-    for (std::int64_t s = std::max<std::int64_t>(0, t - reach); s < std::min(T, t + reach + 1); ++s) {
-      const double g = std::exp(-0.5 * std::pow(static_cast<double>(s - t) / sigma_, 2));
-      spread.select(1, s).select(1, tg.hand) += static_cast<float>(g) * delta;
-      weight[s][tg.hand] += static_cast<float>(g);
-    }
+    for (std::int64_t b = 0; b < B; ++b)
+      for (std::int64_t t = 0; t < T; ++t)
+        for (int hand = 0; hand < 2; ++hand) {
+          const std::size_t th = static_cast<std::size_t>(t * 2 + hand);
+          const std::int64_t o = at_hand(b, t, hand);
+          const float scale = 1.0f / std::max(weight[th], 1.0f);
+          for (std::int64_t i = 0; i < J * 3; ++i) hp[o + i] += pinned[th] ? exact[o + i] : spread[o + i] * scale;
+        }
   }
-  at::Tensor change = spread / weight.clamp_min(1.0).view({1, T, 2, 1, 1});
-  change = at::where(pinned.view({1, T, 2, 1, 1}), exact, change);
-  at::Tensor Hn = H + change;
   // Hands kept off the object: moved rigidly away from the object (from the centre of its
   // points towards the hand's keypoints) until every keypoint is the clearance off every
   // object point. Away from the nearest point alone fails for a hand that is inside the
   // object or wraps it: the nearest point then lies on the far side. On the ramps around the
   // range the clearance fades (ContactConstraint::clearance_at), so the hand lets go and
   // comes back smoothly instead of jumping at the range's ends.
-  Hn = Hn.contiguous();
-  float* const hp = Hn.data_ptr<float>();
   for (const ContactConstraint& a : away_) {
     const FrameRange span = a.with_ramps(first + T);
     const std::int64_t s0 = std::max(span.first - first, std::int64_t{0}), s1 = span.last - first + 1;

@@ -44,23 +44,24 @@ class HandPins : public SampleConstraint {
   // `frame` of the run) imply, and the hand's orientation (world): for tests and checks.
   std::pair<Eigen::Vector3d, Eigen::Matrix3d> wrist_of(const at::Tensor& keypoints, int hand, std::int64_t frame) const;
 
+  using Keys = Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>;
   struct Target {
     int hand = 0;
     std::int64_t frame = 0;
     Eigen::Vector3d wrist;     // canonical frame
     bool turn = false;         // rotation pinned
     Eigen::Matrix3d rotation;  // canonical frame
-    at::Tensor keypoints;      // [J, 3] float32 canonical (pose pin), else undefined
+    Keys keypoints;            // [J, 3] canonical (pose pin), else empty
   };
 
  private:
   struct Palm {
-    at::Tensor rest;        // [P, 3] float64: the palm keypoints of the flat rest hand
-    Eigen::Vector3d wrist;  // its wrist joint
-    at::Tensor index;       // [P] int64: which of the J keypoints are on the palm
+    Points3 rest;            // [P, 3]: the palm keypoints of the flat rest hand
+    Eigen::Vector3d wrist;   // its wrist joint
+    std::vector<int> index;  // [P]: which of the J keypoints are on the palm
   };
   // Rotation R and wrist w of a hand from its keypoints [J, 3] (canonical frame).
-  std::pair<Eigen::Matrix3d, Eigen::Vector3d> fit_palm(const at::Tensor& keypoints, int hand) const;
+  std::pair<Eigen::Matrix3d, Eigen::Vector3d> fit_palm(const Eigen::Ref<const Keys>& keypoints, int hand) const;
 
   std::array<Palm, 2> palms_;
   std::vector<Target> targets_;
