@@ -35,6 +35,7 @@ using namespace bimart::sweep;
 struct SweepArgs {
   std::string file, out, rows, backend = "local", status_dir;
   bool dry_run = false;
+  std::vector<std::string> reuse;
   int jobs = 1;
   // --backend slurm
   std::string partition, account, time_limit, sbatch_args, bimart;
@@ -152,11 +153,21 @@ int run_sweep(const SweepArgs& a) {
   const Plan plan = make_plan(file, dir);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = common_options().threads > 0 ? common_options().threads : cores;
+  const auto elsewhere = finished_elsewhere(plan, a.reuse);
+  const auto list_elsewhere = [&](const char* verb) {
+    if (elsewhere.empty()) return;
+    std::cout << fmt::format("{} {} finished job{} of another sweep (--reuse):\n", verb, elsewhere.size(),
+                             elsewhere.size() == 1 ? "" : "s");
+    for (const auto& [i, from] : elsewhere) std::cout << fmt::format("  {}  {}\n", job_label(plan.jobs[i]), from);
+  };
   if (a.dry_run) {
+    list_elsewhere("would take");
     print_plan(plan, a.jobs, threads);
     return kExitOk;
   }
   const int lock = lock_folder(dir, a.lock_wait);
+  list_elsewhere("taking");
+  adopt_finished(plan, elsewhere);
   write_plan_json(plan);
   RunSummary s;
   if (a.backend == "slurm") {
@@ -245,6 +256,10 @@ void add_sweep_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--out", a.out, "the sweep's folder (default: out/sweeps/<name>)");
   cmd->add_option("--rows", a.rows, "only these rows (comma-separated names)");
   cmd->add_flag("--dry-run", a.dry_run, "print the jobs, what is done, and time estimates; run nothing");
+  cmd->add_option("--reuse", a.reuse,
+                  "another sweep's folder: its finished trainings and evaluations with the same keys are copied, "
+                  "not redone (repeatable)")
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("--jobs", a.jobs, "jobs side by side; the threads are divided between them")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();

@@ -53,6 +53,41 @@ bool is_done(const Job& job) {
   return d.value("key", std::string()) == job.key && fs::exists(job.result);
 }
 
+std::vector<std::pair<std::size_t, std::string>> finished_elsewhere(const Plan& plan,
+                                                                    const std::vector<std::string>& sweeps) {
+  std::vector<std::pair<std::size_t, std::string>> found;
+  for (std::size_t i = 0; i < plan.jobs.size(); ++i) {
+    const Job& job = plan.jobs[i];
+    if (job.kind == JobKind::Generate || is_done(job)) continue;
+    const fs::path rel = fs::path(job.folder).lexically_relative(plan.dir);
+    const fs::path result = fs::path(job.result).lexically_relative(job.folder);
+    for (const std::string& other : sweeps) {
+      std::error_code ec;
+      if (fs::equivalent(other, plan.dir, ec)) continue;
+      Job there = job;
+      there.folder = (fs::path(other) / rel).string();
+      there.result = (fs::path(there.folder) / result).string();
+      if (!is_done(there)) continue;
+      found.emplace_back(i, there.folder);
+      break;
+    }
+  }
+  return found;
+}
+
+void adopt_finished(const Plan& plan, const std::vector<std::pair<std::size_t, std::string>>& found) {
+  for (const auto& [i, from] : found) {
+    const Job& job = plan.jobs[i];
+    fs::create_directories(job.folder);
+    for (const auto& entry : fs::directory_iterator(from)) {
+      const std::string name = entry.path().filename().string();
+      if (!entry.is_regular_file() || name == "done.json" || name == "checkpoint.npz") continue;
+      fs::copy_file(entry.path(), fs::path(job.folder) / name, fs::copy_options::overwrite_existing);
+    }
+    fs::copy_file(fs::path(from) / "done.json", done_file(job), fs::copy_options::overwrite_existing);
+  }
+}
+
 std::vector<bool> needed_jobs(const Plan& plan) {
   const std::size_t n = plan.jobs.size();
   std::vector<std::vector<std::size_t>> dependents(n);

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +26,15 @@ bool is_done(const Job& job);
 // evaluation needs neither its samples nor its models any more, so a sweep folder whose
 // bulky outputs were deleted (or never copied) reruns nothing that is not missing.
 std::vector<bool> needed_jobs(const Plan& plan);
+
+// Jobs finished in another sweep's folder (`--reuse DIR`): train and eval jobs of `plan` not
+// done in its own folder whose folder under one of `sweeps` (the same relative path, so the
+// same key) is done. Returns (job index, that folder), the first sweep that has it.
+std::vector<std::pair<std::size_t, std::string>> finished_elsewhere(const Plan& plan,
+                                                                    const std::vector<std::string>& sweeps);
+// Copies those jobs' files into this sweep's folders (everything but the training state,
+// checkpoint.npz, which a finished training no longer needs), done.json last.
+void adopt_finished(const Plan& plan, const std::vector<std::pair<std::size_t, std::string>>& found);
 
 // A JSON file's content ({} when absent or unreadable).
 nlohmann::json read_json_or_empty(const std::string& path);

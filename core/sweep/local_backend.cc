@@ -31,6 +31,7 @@ enum class State { Pending, Running, Done, Failed, Skipped };
 
 struct Running {
   pid_t pid = -1;
+  int threads = 1;
   Clock::time_point started, last_report;
   ProgressWatch progress;
 };
@@ -60,7 +61,7 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int jobs = std::max(1, o.jobs);
   const int total_threads = o.threads > 0 ? o.threads : cores;
-  const int per_job = std::max(1, total_threads / jobs);
+  const int per_job = std::max(1, total_threads / jobs);  // when `jobs` run side by side
   const std::string program = o.program.empty() ? self_program() : o.program;
   const auto rates = read_rates(plan.dir);
 
@@ -74,8 +75,10 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
     }
   const int to_run = static_cast<int>(plan.jobs.size()) - sum.already_done;
   if (!o.quiet)
-    std::cout << fmt::format("sweep {}: {} jobs, {} done before, {} to run ({} at a time, {} thread{} each)\n", plan.name,
-                             plan.jobs.size(), sum.already_done, to_run, jobs, per_job, per_job == 1 ? "" : "s")
+    std::cout << fmt::format("sweep {}: {} jobs, {} done before, {} to run ({} at a time, {} thread{} each; a job "
+                             "that starts alone gets {})\n",
+                             plan.name, plan.jobs.size(), sum.already_done, to_run, jobs, per_job, per_job == 1 ? "" : "s",
+                             total_threads)
               << std::flush;
 
   const StopSignalScope signals;  // Ctrl-C, SIGTERM: stop the children first
@@ -93,31 +96,42 @@ RunSummary run_local(const Plan& plan, const LocalOptions& o) {
                   << std::flush;
       for (const auto& [i, r] : running) ::kill(r.pid, SIGTERM);
     }
-    // Start what is ready.
-    for (std::size_t i = 0; i < plan.jobs.size() && !stopping && static_cast<int>(running.size()) < jobs; ++i) {
+    // Start what is ready. The threads not used by running jobs are divided among the jobs
+    // starting now, so a job that can only run alone (the last generation of a sweep) gets
+    // them all; a later job that finds them taken gets one (it oversubscribes a little).
+    std::vector<std::size_t> ready;
+    for (std::size_t i = 0; i < plan.jobs.size() && !stopping; ++i) {
       if (state[i] != State::Pending) continue;
-      bool ready = true, blocked = false;
+      bool all_done = true, blocked = false;
       for (const std::size_t d : plan.jobs[i].deps) {
-        ready = ready && state[d] == State::Done;
+        all_done = all_done && state[d] == State::Done;
         blocked = blocked || state[d] == State::Failed || state[d] == State::Skipped;
       }
       if (blocked) {
         state[i] = State::Skipped;
         ++sum.skipped;
-        continue;
+      } else if (all_done) {
+        ready.push_back(i);
       }
-      if (!ready) continue;
+    }
+    int free_threads = total_threads;
+    for (const auto& [i, r] : running) free_threads -= r.threads;
+    int slots = std::min(static_cast<int>(ready.size()), jobs - static_cast<int>(running.size()));
+    for (std::size_t n = 0; slots > 0; ++n, --slots) {
+      const std::size_t i = ready[n];
       const Job& job = plan.jobs[i];
       const bool resumes = resumes_checkpoint(job);
       Running r;
-      r.pid = launch(plan, job, program, per_job);
+      r.threads = std::max(1, free_threads / slots);
+      free_threads -= r.threads;
+      r.pid = launch(plan, job, program, r.threads);
       r.started = r.last_report = Clock::now();
       running[i] = r;
       state[i] = State::Running;
       ++started;
       if (!o.quiet)
-        std::cout << fmt::format("[{}/{}] start {}: estimate {}{}, log {}\n", started, to_run, job_label(job),
-                                 format_duration(estimate_seconds(job, rates, per_job)),
+        std::cout << fmt::format("[{}/{}] start {}: {} thread{}, estimate {}{}, log {}\n", started, to_run, job_label(job),
+                                 r.threads, r.threads == 1 ? "" : "s", format_duration(estimate_seconds(job, rates, r.threads)),
                                  resumes ? " (resumes its checkpoint)" : "", log_file(job))
                   << std::flush;
     }

@@ -119,6 +119,30 @@ TEST_F(Sweep, AChangedRowRerunsOnlyThatRow) {
   EXPECT_NE(ta[1]["run"], tb[1]["run"]);
 }
 
+TEST_F(Sweep, ReuseTakesAnotherSweepsFinishedJobsWithTheSameKeys) {
+  ASSERT_EQ(exit_code(*first_), 0) << first_->output;
+  // A new folder, one row changed: the two models and the unchanged rows' evaluations come
+  // from the first sweep's folder; only the changed row's run and evaluation run.
+  const fs::path e = scratch() / "e";
+  write(scratch() / "sweep_e.yaml", sweep_text(", motion.cfg: 0"));
+  const std::string cmd = "sweep " + (scratch() / "sweep_e.yaml").string() + " --out " + e.string() + " --reuse " +
+                          (scratch() / "a").string();
+  const auto dry = test::run_bimart(cmd + " --dry-run");
+  ASSERT_EQ(exit_code(dry), 0) << dry.output;
+  EXPECT_NE(dry.output.find("would take 3 finished jobs of another sweep"), std::string::npos) << dry.output;
+  EXPECT_FALSE(fs::exists(e / "evals"));  // a dry run copies nothing
+  const auto r = test::run_bimart(cmd);
+  ASSERT_EQ(exit_code(r), 0) << r.output;
+  EXPECT_NE(r.output.find("taking 3 finished jobs"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("2 jobs ran, 4 were done before"), std::string::npos) << r.output;  // 3 taken, and the run they no longer need
+  const auto ta = nlohmann::json::parse(read(scratch() / "a" / "table.json"));
+  const auto te = nlohmann::json::parse(read(e / "table.json"));
+  EXPECT_EQ(ta[0]["ours"], te[0]["ours"]);
+  EXPECT_NE(ta[1]["run"], te[1]["run"]);
+  for (const auto& entry : fs::recursive_directory_iterator(e / "models"))
+    EXPECT_NE(entry.path().filename(), "checkpoint.npz");  // never the training state
+}
+
 TEST_F(Sweep, KilledWithSigkillAndRerunGivesTheSameTable) {
   ASSERT_EQ(exit_code(*first_), 0) << first_->output;
   const fs::path c = scratch() / "c";
