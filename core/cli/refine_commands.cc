@@ -200,14 +200,19 @@ int refine(RefineCliOptions o) {
     shifted += p.shifted_frames;
   }
   const double n = static_cast<double>(results.size());
-  std::cout << fmt::format("{:<28}{:>10}{:>10}{:>10}{:>10}{:>10}{:>14}\n", "", "Accel ↓", "Pen 1cm ↓", "Pen 5mm ↓",
-                           "Con ↑", "Art ↑", "joint err mm");
+  std::cout << fmt::format("{:<28}{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}{:>14}\n", "", "Accel ↓", "Pen 1cm ↓",
+                           "Pen 5mm ↓", "Pen 3mm ↓", "Depth ↓", "Con ↑", "Art ↑", "joint err mm");
   for (int r = 0; r < kRows; ++r) {
     const auto& t = table[static_cast<size_t>(r)];
+    const auto col = [&](const char* name) {
+      for (const auto& m : t)
+        if (m.name == name) return cell(m);
+      throw Error(std::string("refine table: no column ") + name);
+    };
     std::string err = r == kFit ? fmt::format("{:.2f}", 1e3 * jf / n)
                                 : (r == kRefined ? fmt::format("{:.2f}", 1e3 * jr / n) : std::string("-"));
-    std::cout << fmt::format("{:<28}{:>10}{:>10}{:>10}{:>10}{:>10}{:>14}\n", kRowNames[r], cell(t[1]), cell(t[2]),
-                             cell(t[3]), cell(t[4]), cell(t[5]), err);
+    std::cout << fmt::format("{:<28}{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}{:>10}{:>14}\n", kRowNames[r], col("Accel"),
+                             col("Pen 1cm"), col("Pen 5mm"), col("Pen 3mm"), col("Depth"), col("Con"), col("Art"), err);
   }
   std::cout << fmt::format(
       "{} sequences, {} frames; keypoints: {} (mean error to the truth {:.2f} mm, {:.1f}% of hand-frames shifted "
@@ -218,7 +223,7 @@ int refine(RefineCliOptions o) {
       "threads\n",
       sf, sr, (sf + sr) * 64.0 / static_cast<double>(frames), wall, threads);
   std::cout << "rows: 'keypoints' rows measure the 100 keypoints per hand as if they were the mesh; units: "
-               "Accel cm/frame², Pen/Con/Art % of frames\n";
+               "Accel cm/frame², Pen/Con/Art % of frames, Depth mm (mean over contact frames)\n";
   if (!o.no_write) std::cout << "wrote " << (fs::path(o.out) / "fit").string() << " and " << (fs::path(o.out) / "refined").string() << "\n";
 
   if (!o.json.empty()) {

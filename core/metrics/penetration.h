@@ -10,6 +10,7 @@ namespace bimart {
 
 constexpr double kPenetration1cm = 0.01;   // m
 constexpr double kPenetration5mm = 0.005;  // m
+constexpr double kPenetration3mm = 0.003;  // m
 
 // hits = frames with whole-object depth > threshold; frames = all frames.
 FrameCount penetration_frames(const FrameDepths& depths, double threshold);

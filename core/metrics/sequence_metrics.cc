@@ -1,5 +1,6 @@
 #include "core/metrics/sequence_metrics.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/metrics/accel.h"
@@ -26,6 +27,12 @@ SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectD
   m.accel = mean_acceleration(d.hand_vertices);
   m.pen_1cm = penetration_frames(depths, kPenetration1cm);
   m.pen_5mm = penetration_frames(depths, kPenetration5mm);
+  m.pen_3mm = penetration_frames(depths, kPenetration3mm);
+  for (size_t t = 0; t < depths.size(); ++t) {
+    if (depths.whole(t) <= -kContactDistance) continue;
+    m.contact_depth_sum += std::max(depths.whole(t), 0.0);
+    ++m.contact_depth_frames;
+  }
   m.contact = contact_frames(depths, object_moving_frames(object, d.object_states));
   m.articulation = articulation_frames(depths, angle_changing_frames(d.object_states));
   if (d.contact_maps.defined() && d.basis_hit_indices.defined() && d.hand_keypoints.defined())
@@ -68,6 +75,22 @@ MetricResult contact_map_result(const std::vector<SequenceMetrics>& s) {
   return mean_result("CM", "cm", false, v);
 }
 
+MetricResult contact_depth_result(const std::vector<SequenceMetrics>& s) {
+  MetricResult r;
+  r.name = "Depth";
+  r.unit = "mm";
+  r.higher_is_better = false;
+  double sum = 0;
+  std::int64_t frames = 0;
+  for (const auto& m : s) {
+    sum += m.contact_depth_sum;
+    frames += m.contact_depth_frames;
+  }
+  r.num_sequences = static_cast<std::int64_t>(s.size());
+  r.value = frames ? 1000.0 * sum / static_cast<double>(frames) : std::numeric_limits<double>::quiet_NaN();
+  return r;
+}
+
 MetricResult frame_share_result(const std::string& name, bool higher,
                                 const std::vector<SequenceMetrics>& s, FrameCount SequenceMetrics::*field) {
   MetricResult r;
@@ -91,6 +114,8 @@ std::vector<MetricResult> aggregate_metrics(const std::vector<SequenceMetrics>& 
           accel_result(s),
           frame_share_result("Pen 1cm", false, s, &SequenceMetrics::pen_1cm),
           frame_share_result("Pen 5mm", false, s, &SequenceMetrics::pen_5mm),
+          frame_share_result("Pen 3mm", false, s, &SequenceMetrics::pen_3mm),
+          contact_depth_result(s),
           frame_share_result("Con", true, s, &SequenceMetrics::contact),
           frame_share_result("Art", true, s, &SequenceMetrics::articulation),
           contact_map_result(s)};

@@ -21,7 +21,12 @@ struct SequenceMetrics {
   std::string name;
   std::int64_t frames = 0;
   double accel = std::numeric_limits<double>::quiet_NaN();  // m/frame²; NaN when N < 3
-  FrameCount pen_1cm, pen_5mm, contact, articulation;
+  FrameCount pen_1cm, pen_5mm, pen_3mm, contact, articulation;
+  // The deepest penetration (m, 0 when outside) summed over the frames where a hand touches
+  // the object (deepest vertex within kContactDistance of it, or inside), and their count:
+  // the "Depth" column, a hand resting on the surface against one sunk into it.
+  double contact_depth_sum = 0;
+  std::int64_t contact_depth_frames = 0;
   double contact_map = std::numeric_limits<double>::quiet_NaN();  // m; NaN without a condition
 };
 
@@ -39,7 +44,8 @@ struct SequenceData {
 SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectDistance& distance,
                                   const SequenceData& data);
 
-// The table's columns in the paper's order: Mul, Accel, Pen 1cm, Pen 5mm, Con, Art, CM.
+// The table's columns: the paper's Mul, Accel, Pen 1cm, Pen 5mm, then Pen 3mm and Depth (mm,
+// the mean deepest penetration over contact frames), then Con, Art, CM.
 // `mul_per_trajectory` in metres (one value per trajectory with >= 2 samples). A column
 // with nothing to average has value NaN and num_sequences 0.
 std::vector<MetricResult> aggregate_metrics(const std::vector<SequenceMetrics>& sequences,
@@ -52,5 +58,6 @@ MetricResult frame_share_result(const std::string& name, bool higher_is_better,
                                 const std::vector<SequenceMetrics>& sequences,
                                 FrameCount SequenceMetrics::*field);
 MetricResult contact_map_result(const std::vector<SequenceMetrics>& sequences);
+MetricResult contact_depth_result(const std::vector<SequenceMetrics>& sequences);
 
 }  // namespace bimart

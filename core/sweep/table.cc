@@ -30,8 +30,9 @@ Column column_info(const std::string& name) {
   if (name == "Mul") return {"cm", true, 2};
   if (name == "Accel") return {"", false, 3};
   if (name == "CM") return {"cm", false, 2};
+  if (name == "Depth") return {"mm", false, 2};
   if (name == "Con" || name == "Art") return {"%", true, 2};
-  return {"%", false, 2};  // Pen 1cm, Pen 5mm
+  return {"%", false, 2};  // Pen 1cm, Pen 5mm, Pen 3mm
 }
 
 std::string header(const std::string& m) {

@@ -99,12 +99,16 @@ TEST(EvalCli, TableAndJsonOnATinyFolder) {
   EXPECT_EQ(g["metrics"][2]["name"], "Pen 1cm");
   EXPECT_EQ(g["metrics"][2]["denominator"], 24);  // all frames of all sequences
   EXPECT_EQ(g["metrics"][2]["numerator"], 0);
-  EXPECT_EQ(g["metrics"][4]["name"], "Con");
-  EXPECT_EQ(g["metrics"][4]["denominator"], 14);  // 7 moving frames in each of a_s0, a_s1
-  EXPECT_EQ(g["metrics"][4]["numerator"], 0);     // hands half a metre away
-  EXPECT_EQ(g["metrics"][5]["name"], "Art");
-  EXPECT_EQ(g["metrics"][5]["denominator"], 14);
-  EXPECT_TRUE(g["metrics"][6]["value"].is_null());  // no conditioning maps stored: no CM
+  EXPECT_EQ(g["metrics"][4]["name"], "Pen 3mm");
+  EXPECT_EQ(g["metrics"][4]["numerator"], 0);
+  EXPECT_EQ(g["metrics"][5]["name"], "Depth");
+  EXPECT_TRUE(g["metrics"][5]["value"].is_null());  // no frame touches: no depth to average
+  EXPECT_EQ(g["metrics"][6]["name"], "Con");
+  EXPECT_EQ(g["metrics"][6]["denominator"], 14);  // 7 moving frames in each of a_s0, a_s1
+  EXPECT_EQ(g["metrics"][6]["numerator"], 0);     // hands half a metre away
+  EXPECT_EQ(g["metrics"][7]["name"], "Art");
+  EXPECT_EQ(g["metrics"][7]["denominator"], 14);
+  EXPECT_TRUE(g["metrics"][8]["value"].is_null());  // no conditioning maps stored: no CM
   EXPECT_EQ(g["per_sequence"].size(), 3u);
 
   const CliRun gt = run_cli("--ground-truth " + (dir / "data").string() + " --split test --quiet");

@@ -137,15 +137,25 @@ TEST(SequenceMetrics, EndToEndOnABoxWithPlacedVertices) {
   EXPECT_EQ(m.articulation.frames, 2);
   EXPECT_EQ(m.articulation.hits, 1);
   EXPECT_TRUE(std::isnan(m.contact_map));
+  // Pen 3mm: frames 0 and 1; frames 2 and 3 are 3 mm deep, not more. Depth: the contact
+  // frames 0..3 at 20, 7, 3 and 3 mm (frame 3 inside the closed top part).
+  EXPECT_EQ(m.pen_3mm.hits, 2);
+  EXPECT_EQ(m.contact_depth_frames, 4);
+  EXPECT_NEAR(m.contact_depth_sum, 0.033, 1e-9);
   const auto table = aggregate_metrics({m, m}, {0.01, 0.03});
-  ASSERT_EQ(table.size(), 7u);
+  ASSERT_EQ(table.size(), 9u);
   EXPECT_EQ(table[0].name, "Mul");
   EXPECT_NEAR(table[0].value, 2.0, 1e-12);
   EXPECT_EQ(table[2].name, "Pen 1cm");
   EXPECT_EQ(table[2].numerator, 2);
   EXPECT_EQ(table[2].denominator, 12);
-  EXPECT_NEAR(table[4].value, 80.0, 1e-12);
-  EXPECT_TRUE(std::isnan(table[6].value));
+  EXPECT_EQ(table[4].name, "Pen 3mm");
+  EXPECT_EQ(table[4].numerator, 4);
+  EXPECT_EQ(table[5].name, "Depth");
+  EXPECT_EQ(table[5].unit, "mm");
+  EXPECT_NEAR(table[5].value, 8.25, 1e-6);
+  EXPECT_NEAR(table[6].value, 80.0, 1e-12);
+  EXPECT_TRUE(std::isnan(table[8].value));
 }
 
 TEST(HandVertices, PosesWithTheShippedModelWhenVerticesAreMissing) {
