@@ -166,6 +166,17 @@ at::Tensor NormalizationStats::denormalize_mano(const at::Tensor& m) const {
   return denormalize(m, mano_mean, mano_std);
 }
 
+at::Tensor NormalizationStats::normalize_joints(const at::Tensor& j) const {
+  if (!mano_mean.defined()) throw Error("normalize_joints: these statistics hold no MANO representation");
+  const at::Tensor c = at::tensor(mano_representation_joint_columns(), at::kLong);
+  return normalize(j, mano_mean.index_select(0, c), mano_std.index_select(0, c));
+}
+at::Tensor NormalizationStats::denormalize_joints(const at::Tensor& j) const {
+  if (!mano_mean.defined()) throw Error("denormalize_joints: these statistics hold no MANO representation");
+  const at::Tensor c = at::tensor(mano_representation_joint_columns(), at::kLong);
+  return denormalize(j, mano_mean.index_select(0, c), mano_std.index_select(0, c));
+}
+
 at::Tensor NormalizationStats::normalize_object(const at::Tensor& object_features,
                                                 const at::Tensor& global_states) const {
   return normalize(object_condition(object_features, global_states), obj_mean, obj_std);

@@ -55,6 +55,9 @@ struct NormalizationStats {
   // MANO-Rep [..., 294] -> normalised, and back; throws when the statistics have none.
   at::Tensor normalize_mano(const at::Tensor& m) const;
   at::Tensor denormalize_mano(const at::Tensor& m) const;
+  // Both hands' joints [..., 96] (MANO-Rep's joint columns) with those columns' statistics.
+  at::Tensor normalize_joints(const at::Tensor& j) const;
+  at::Tensor denormalize_joints(const at::Tensor& j) const;
   // O [..., 1024, 3] and G [..., 7] -> the normalised object condition [..., 3079].
   at::Tensor normalize_object(const at::Tensor& object_features, const at::Tensor& global_states) const;
   // C [..., 2, 1024] -> normalised (in log space when c_log_eps > 0), same shape; and back.

@@ -95,6 +95,7 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
   if (i.schedule_shift != 1.0) f.set("diffusion/shift", make_npy_scalar<double>(i.schedule_shift));
   set_string(f, "encoder/variant", i.variant);
   set_string(f, "representation", i.representation);
+  set_string(f, "condition", i.condition);
   if (!i.basis_points.defined()) throw Error(path + ": checkpoint without basis points");
   f.set("encoder/basis_points", npy_from_tensor(i.basis_points.to(at::kFloat)));
   f.set("hand/keypoints", make_npy(i.keypoints));
@@ -169,6 +170,16 @@ Checkpoint load_checkpoint(const std::string& path) {
                   " numbers per frame, the network " + std::to_string(i.network.sample_size));
   } catch (const Error& e) {
     throw Error(f.where("representation") + ": " + e.what());
+  }
+  // Checkpoints from before the baselines are conditioned on C (motion) or nothing (contact).
+  i.condition = f.contains("condition") ? get_string(f, "condition") : kContactCondition;
+  try {
+    check_condition_name(i.condition);
+    if (i.network.model == "motion" && i.network.contact_condition_size != condition_size(i.condition))
+      throw Error("condition " + i.condition + " is " + std::to_string(condition_size(i.condition)) +
+                  " numbers per frame, the network's " + std::to_string(i.network.contact_condition_size));
+  } catch (const Error& e) {
+    throw Error(f.where("condition") + ": " + e.what());
   }
   i.basis_points = tensor_from_npy(f.get("encoder/basis_points", {-1, 3}), f.where("encoder/basis_points"));
   i.keypoints = f.vector<std::int64_t>("hand/keypoints");

@@ -33,6 +33,8 @@ struct ModelInfo {
   std::string variant = "np_bps";  // encoder of O (bps_variant_name)
   // The motion model's sample (core/diffusion/representation.h); files without it: "keypoints".
   std::string representation = "keypoints";
+  // The motion model's second condition (representation.h); files without it: "contact".
+  std::string condition = "contact";
   at::Tensor basis_points;         // [1024, 3] float32, encoder space
   std::vector<std::int64_t> keypoints;  // J = 100 hand keypoint vertex ids
   NormalizationStats normalization;

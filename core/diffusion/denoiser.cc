@@ -48,8 +48,6 @@ void DenoiserConfig::validate() const {
   require(sample_size > 0, "sample_size", "must be positive");
   require(object_condition_size > 0, "object_condition_size", "must be positive");
   require(contact_condition_size >= 0, "contact_condition_size", "must not be negative");
-  require(model != "motion" || contact_condition_size > 0, "contact_condition_size",
-          "must be positive for the motion model");
   require(window >= 1 && window <= 4096, "window", "must be in [1, 4096], got " + std::to_string(window));
   require(latent >= 8 && latent <= 8192, "latent", "must be in [8, 8192], got " + std::to_string(latent));
   require(heads >= 1 && latent % heads == 0, "heads",

@@ -11,6 +11,7 @@
 #include "core/diffusion/object_condition.h"
 #include "core/diffusion/representation.h"
 #include "core/diffusion/temporal_band.h"
+#include "core/features/mano_representation.h"
 #include "core/util/error.h"
 
 namespace bimart::diffusion {
@@ -139,14 +140,21 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
     throw Error("generate: need O [N, 1024, 3] and G [N, 7], got " + c10::str(O.sizes()) + " and " + c10::str(G.sizes()));
   if (N < 1) throw Error("generate: the trajectory has no frames");
   const bool mano = motion && info.representation == kManoRepresentation;
-  if (mano && guidance != nullptr)
-    throw Error(path_ + ": guidance corrects keypoints X = [H | D], but this model samples the MANO representation "
-                "(MANO-Rep): run it without a guidance stage");
+  const bool joints = motion && info.representation == kJointsRepresentation;
+  if ((mano || joints) && guidance != nullptr)
+    throw Error(path_ + ": guidance corrects keypoints X = [H | D], but this model samples " +
+                describe_representation(info.representation) + ": run it without a guidance stage");
   if (mano && constraint != nullptr)
     throw Error(path_ + ": pinned hands are imposed on keypoints X = [H | D], but this model samples the MANO "
                 "representation (MANO-Rep): use a keypoint motion model (motion.diffusion) to direct the hands");
   at::Tensor contact;
-  if (motion && o.use_contact) {
+  if (motion && info.condition == kJointsCondition) {
+    // OMOMO-B's second stage: the joints of both hands [N, 96] or [S, N, 96] (m, canonical).
+    if (!C.defined()) throw Error(path_ + ": this model is conditioned on the joint positions of both hands; none given");
+    contact = C.dim() == 2 ? C.unsqueeze(0).expand({S, N, C.size(-1)}) : C;
+    if (contact.dim() != 3 || contact.size(0) != S || contact.size(1) != N || contact.size(2) != kManoRepJointsSize)
+      throw Error("generate: joints must be [N, 96] or [" + std::to_string(S) + ", N, 96], got " + c10::str(C.sizes()));
+  } else if (motion && info.condition == kContactCondition && o.use_contact) {
     if (!C.defined()) throw Error(path_ + ": the motion model needs contact maps (or use_contact off)");
     contact = C.dim() == 3 ? C.unsqueeze(0).expand({S, N, 2, 1024}) : C;
     if (contact.dim() != 4 || contact.size(0) != S || contact.size(1) != N || contact.size(2) != 2 || contact.size(3) != 1024)
@@ -173,7 +181,9 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
     cond_emb = net_->encode_conditions(obj);
   } else {
     at::Tensor c_w;
-    if (contact.defined()) c_w = lay.split(st.normalize_c(contact.to(at::kFloat)).flatten(-2));
+    if (contact.defined())
+      c_w = lay.split(info.condition == kJointsCondition ? st.normalize_joints(contact.to(at::kFloat))
+                                                         : st.normalize_c(contact.to(at::kFloat)).flatten(-2));
     const at::Tensor with = contact.defined() ? net_->encode_conditions(obj, c_w) : net_->encode_conditions(obj);
     cond_emb = o.cfg_lambda != 0.0 && contact.defined() ? at::cat({with, net_->encode_conditions(obj)}, 0) : with;
   }
@@ -196,13 +206,20 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
     return st.normalize_x(metres + at::cat(corr, 0));
   };
   // The constraint imposed on x0 (normalised) window by window, in the model's units.
+  const auto to_units = [&](const at::Tensor& w) {
+    if (!motion) return st.contact_from_sample(w).flatten(-2);
+    return joints ? st.denormalize_joints(w) : st.denormalize_x(w);
+  };
+  const auto from_units = [&](const at::Tensor& u) {
+    if (!motion) return st.contact_sample(u.unflatten(-1, {2, 1024}));
+    return joints ? st.normalize_joints(u) : st.normalize_x(u);
+  };
   const auto constrain = [&](const at::Tensor& x0, int t) {
     std::vector<at::Tensor> parts;
     for (std::int64_t k = 0; k < K; ++k) {
-      const at::Tensor w = x0.slice(0, k * S, (k + 1) * S);
-      const at::Tensor units = motion ? st.denormalize_x(w) : st.contact_from_sample(w).flatten(-2);
-      const at::Tensor fixed = constraint->impose(units, lay.spans[k].first, t, schedule_.steps);
-      parts.push_back(motion ? st.normalize_x(fixed) : st.contact_sample(fixed.unflatten(-1, {2, 1024})));
+      const at::Tensor fixed =
+          constraint->impose(to_units(x0.slice(0, k * S, (k + 1) * S)), lay.spans[k].first, t, schedule_.steps);
+      parts.push_back(from_units(fixed));
     }
     return at::cat(parts, 0).to(x0.scalar_type());
   };
@@ -222,7 +239,9 @@ at::Tensor DiffusionModel::generate(const at::Tensor& O, const at::Tensor& G, co
   const StepHook hook = [&](int, int, at::Tensor& x) { x = agree(x); };
   const at::Tensor result = lay.fuse(sample(schedule_, predict, noise, o.sampler, gen, hook));
   if (mano) return st.denormalize_mano(result);
-  at::Tensor out = motion ? st.denormalize_x(result) : st.contact_from_sample(result).clamp_min(0.0);
+  at::Tensor out = joints   ? st.denormalize_joints(result)
+                   : motion ? st.denormalize_x(result)
+                            : st.contact_from_sample(result).clamp_min(0.0);
   if (constraint == nullptr) return out;
   // Exactly on the result too (the contact basis cannot hold every imposed value).
   const at::Tensor flat = motion ? out : out.flatten(-2);

@@ -48,11 +48,14 @@ class DiffusionModel {
 
   // Generates S = options.samples samples for N frames.
   // object_features O [N, 1024, 3], global_states G [N, 7] (translation relative to any
-  // fixed frame: each window subtracts its own first translation); contact_maps (motion
-  // model) [N, 2, 1024] or [S, N, 2, 1024] in metres, or undefined when use_contact is false.
+  // fixed frame: each window subtracts its own first translation); contact_maps: the motion
+  // model's second condition (ModelInfo::condition) — C [N, 2, 1024] or [S, N, 2, 1024] in
+  // metres (undefined when use_contact is false), the joints [N, 96] or [S, N, 96] (m,
+  // canonical) for a model conditioned on them, undefined for one conditioned on nothing.
   // Returns, denormalised: contact model C [S, N, 2, 1024] (m, clamped at 0); motion
   // model X [S, N, 1200] (m, canonical frame), or for a MANO-Rep model (which takes no
-  // guidance) its sample [S, N, 294] (core/features/mano_representation.h).
+  // guidance) its sample [S, N, 294] (core/features/mano_representation.h), or for a joints
+  // model the joints [S, N, 96].
   // `constraint` (optional) is imposed on every step's clean-sample prediction, after the
   // guidance, and on the result: contact model on C [B, T, 2048] (m), motion model on X
   // (stages/sample_constraint.h); a MANO-Rep model takes none.

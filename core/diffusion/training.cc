@@ -24,6 +24,7 @@
 #include "core/diffusion/distributed.h"
 #include "core/diffusion/object_condition.h"
 #include "core/diffusion/representation.h"
+#include "core/features/mano_representation.h"
 #include "core/diffusion/schedule.h"
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
@@ -66,12 +67,12 @@ void read(const std::string& file, const YAML::Node& map, const char* key, T& ou
 }
 
 void set_sizes(DenoiserConfig& n, const std::string& model, int contact_basis, bool global_states,
-               const std::string& representation) {
+               const std::string& representation, const std::string& condition) {
   n.model = model;
   n.sample_size = model != "contact" ? motion_sample_size(representation)
                   : contact_basis > 0 ? 2 * contact_basis : 2 * kBasisRows;
   n.object_condition_size = object_condition_size(global_states);
-  n.contact_condition_size = model == "contact" ? 0 : 2 * kBasisRows;
+  n.contact_condition_size = model == "contact" ? 0 : condition_size(condition);
 }
 
 // ---- helpers ----
@@ -195,7 +196,7 @@ TrainConfig load_train_config(const std::string& path) {
     c.text = s.str();
   }
   check_keys(path, root, "the training config",
-             {"model", "data", "out", "export", "export_half", "init", "variant", "representation", "stride", "network",
+             {"model", "data", "out", "export", "export_half", "init", "variant", "representation", "condition", "stride", "network",
               "diffusion", "training"});
   read(path, root, "model", c.model);
   if (c.model != "contact" && c.model != "motion")
@@ -208,12 +209,18 @@ TrainConfig load_train_config(const std::string& path) {
   read(path, root, "init", c.init);
   read(path, root, "variant", c.variant);
   read(path, root, "representation", c.representation);
-  if (c.representation != kKeypointsRepresentation && c.representation != kManoRepresentation)
-    throw Error(where(path, root["representation"]) + ": 'representation' must be keypoints or mano, got '" +
+  if (c.representation != kKeypointsRepresentation && c.representation != kManoRepresentation &&
+      c.representation != kJointsRepresentation)
+    throw Error(where(path, root["representation"]) + ": 'representation' must be keypoints, mano or joints, got '" +
                 c.representation + "'");
-  if (c.representation == kManoRepresentation && c.model != "motion")
-    throw Error(where(path, root["representation"]) +
-                ": 'representation: mano' is for the motion model only; the contact model samples contact maps");
+  if (c.representation != kKeypointsRepresentation && c.model != "motion")
+    throw Error(where(path, root["representation"]) + ": 'representation: " + c.representation +
+                "' is for the motion model only; the contact model samples contact maps");
+  read(path, root, "condition", c.condition);
+  if (c.condition != kContactCondition && c.condition != kNoCondition && c.condition != kJointsCondition)
+    throw Error(where(path, root["condition"]) + ": 'condition' must be contact, none or joints, got '" + c.condition + "'");
+  if (c.condition != kContactCondition && c.model != "motion")
+    throw Error(where(path, root["condition"]) + ": 'condition' is for the motion model only");
   read(path, root, "stride", c.stride);
   if (const YAML::Node n = root["network"]) {
     check_keys(path, n, "network",
@@ -261,7 +268,7 @@ TrainConfig load_train_config(const std::string& path) {
     read(path, n, "validation_windows", c.validation_windows);
     read(path, n, "log_every", c.log_every);
   }
-  set_sizes(c.network, c.model, c.contact_basis, c.global_states, c.representation);
+  set_sizes(c.network, c.model, c.contact_basis, c.global_states, c.representation, c.condition);
   try {
     validate(c);
   } catch (const Error& e) {
@@ -281,6 +288,14 @@ void validate(const TrainConfig& c) {
   check_representation_name(c.representation);
   need(c.representation == kKeypointsRepresentation || c.model == "motion",
        "'representation: " + c.representation + "' is for the motion model only; the contact model samples contact maps");
+  check_condition_name(c.condition);
+  need(c.condition == kContactCondition || c.model == "motion", "'condition' is for the motion model only");
+  need(!(c.condition == kJointsCondition && c.representation == kJointsRepresentation),
+       "a model that samples the joints cannot be conditioned on them ('condition: joints' with 'representation: joints')");
+  if (c.model == "motion")
+    need(c.network.contact_condition_size == condition_size(c.condition),
+         "the motion model's second condition must be " + std::to_string(condition_size(c.condition)) +
+             " wide for condition " + c.condition + ", got " + std::to_string(c.network.contact_condition_size));
   if (c.model == "motion")
     need(c.network.sample_size == motion_sample_size(c.representation),
          "the motion model's sample size must be " + std::to_string(motion_sample_size(c.representation)) +
@@ -328,10 +343,20 @@ double learning_rate(const TrainConfig& c, std::int64_t step) {
 at::Tensor normalized_sample(const std::string& model, const std::string& representation,
                              const NormalizationStats& stats, const WindowBatch& b) {
   if (model == "contact") return stats.contact_sample(b.contact_maps);
-  if (representation != kManoRepresentation) return stats.normalize_x(b.hand_features);
+  if (representation == kKeypointsRepresentation) return stats.normalize_x(b.hand_features);
   if (!b.mano.defined())
     throw Error("the batch holds no MANO representation (open the data set with WindowDatasetOptions::mano)");
+  if (representation == kJointsRepresentation) return stats.normalize_joints(mano_representation_joints(b.mano));
   return stats.normalize_mano(b.mano);
+}
+
+at::Tensor normalized_condition(const std::string& model, const std::string& condition, const NormalizationStats& stats,
+                                const WindowBatch& b) {
+  if (model != "motion" || condition == kNoCondition) return {};
+  if (condition == kContactCondition) return stats.normalize_c(b.contact_maps).flatten(-2);
+  if (!b.mano.defined())
+    throw Error("the batch holds no MANO representation (open the data set with WindowDatasetOptions::mano)");
+  return stats.normalize_joints(mano_representation_joints(b.mano));
 }
 
 StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stats, const WindowBatch& b,
@@ -340,10 +365,8 @@ StepInputs make_step_inputs(const TrainConfig& c, const NormalizationStats& stat
   const auto B = b.mask.size(0);
   in.object = model_object_condition(c.network, stats, b.object_features, b.global_states);
   in.sample = normalized_sample(c.model, c.representation, stats, b);
-  if (c.model == "motion") {
-    in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
-    in.use_contact = at::rand({B}, gen) >= c.contact_dropout;
-  }
+  in.contact = normalized_condition(c.model, c.condition, stats, b);
+  if (in.contact.defined()) in.use_contact = at::rand({B}, gen) >= c.contact_dropout;
   in.mask = b.mask;
   in.noise = at::randn(in.sample.sizes(), gen);
   in.t = at::randint(0, c.diffusion_steps, {B}, gen, at::kLong);
@@ -442,7 +465,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   WindowDatasetOptions wo;
   wo.variant = parse_bps_variant(config.variant);
   wo.stride = config.stride;
-  wo.mano = config.representation == kManoRepresentation;
+  wo.mano = config.representation != kKeypointsRepresentation || config.condition == kJointsCondition;
   std::unique_ptr<ProgressBar> bar;
   wo.progress = [&](std::size_t done, std::size_t total) {
     if (!bar) bar = std::make_unique<ProgressBar>("features", total, show);
@@ -467,6 +490,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
   info.schedule_shift = config.schedule_shift;
   info.variant = config.variant;
   info.representation = config.representation;
+  info.condition = config.condition;
   info.basis_points = train_set.basis_points();
   info.keypoints = posing_keypoint_ids();
   info.normalization = stats;
@@ -589,7 +613,7 @@ TrainResult train(const TrainConfig& config, const TrainOptions& options) {
       StepInputs in;
       in.object = model_object_condition(config.network, stats, b.object_features, b.global_states);
       in.sample = normalized_sample(config.model, config.representation, stats, b);
-      if (config.model == "motion") in.contact = stats.normalize_c(b.contact_maps).flatten(-2);
+      in.contact = normalized_condition(config.model, config.condition, stats, b);
       in.mask = b.mask;
       in.noise = at::randn(in.sample.sizes(), gen);
       in.t = at::randint(0, config.diffusion_steps, {in.sample.size(0)}, gen, at::kLong);

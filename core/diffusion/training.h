@@ -42,6 +42,9 @@ struct TrainConfig {
   // Motion model: what it samples, "keypoints" (X = [H | D], the method) or "mano" (MANO-Rep,
   // core/diffusion/representation.h). The contact model refuses "mano".
   std::string representation = "keypoints";
+  // Motion model: its second condition (core/diffusion/representation.h): "contact" (C, the
+  // method), "none" (MDM-B, OMOMO-B's first stage) or "joints" (OMOMO-B's second stage).
+  std::string condition = "contact";
   int stride = 16;         // window stride of the training windows
   DenoiserConfig network;
   // Contact model: > 0 samples C in log space, log(C + contact_log_eps) normalised (metres;
@@ -128,9 +131,13 @@ int warm_start(torch::nn::Module& net, const std::map<std::string, at::Tensor>& 
 
 // What a model denoises, normalised: the contact maps C [B, T, 2048] ("contact"), or for
 // "motion" the hand features X [B, T, 1200] (representation "keypoints") or MANO-Rep
-// [B, T, 294] ("mano") of a batch.
+// [B, T, 294] ("mano") or the joints [B, T, 96] ("joints") of a batch.
 at::Tensor normalized_sample(const std::string& model, const std::string& representation,
                              const NormalizationStats& stats, const WindowBatch& batch);
+// A motion model's second condition, normalised: C [B, T, 2048] ("contact"), the joints
+// [B, T, 96] ("joints"), or undefined ("none", and for the contact model).
+at::Tensor normalized_condition(const std::string& model, const std::string& condition,
+                                const NormalizationStats& stats, const WindowBatch& batch);
 // Builds StepInputs from a batch: normalisation, and noise, steps and contact dropout
 // drawn from `gen`.
 StepInputs make_step_inputs(const TrainConfig& config, const NormalizationStats& stats,

@@ -40,6 +40,23 @@ Eigen::Vector3d rest_wrist(const HandModel& model, const at::Tensor& shape) {
 
 }  // namespace
 
+const std::vector<std::int64_t>& mano_representation_joint_columns() {
+  static const std::vector<std::int64_t> columns = [] {
+    std::vector<std::int64_t> c;
+    for (int h = 0; h < 2; ++h)
+      for (int i = 0; i < HandModel::kNumJoints * 3; ++i) c.push_back(h * kManoRepHandSize + kManoRepJoints + i);
+    return c;
+  }();
+  return columns;
+}
+
+at::Tensor mano_representation_joints(const at::Tensor& rep) {
+  if (rep.dim() < 1 || rep.size(-1) != kManoRepSize)
+    throw Error("MANO-Rep joints: need [..., " + std::to_string(kManoRepSize) + "], got " + c10::str(rep.sizes()));
+  const std::vector<std::int64_t>& c = mano_representation_joint_columns();
+  return rep.index_select(-1, at::tensor(c, at::kLong));
+}
+
 at::Tensor rotation_to_6d(const at::Tensor& r) {
   return at::cat({r.select(-1, 0), r.select(-1, 1)}, -1);
 }

@@ -12,6 +12,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <vector>
 
 #include <ATen/core/Tensor.h>
 
@@ -24,6 +26,7 @@ constexpr int kManoRepHandSize = HandModel::kNumJoints * 6 + 3 + HandModel::kNum
 constexpr int kManoRepSize = 2 * kManoRepHandSize;                                           // 294
 constexpr int kManoRepWrist = HandModel::kNumJoints * 6;  // offset of the wrist within a hand's block
 constexpr int kManoRepJoints = kManoRepWrist + 3;         // offset of the joints
+constexpr int kManoRepJointsSize = 2 * HandModel::kNumJoints * 3;  // 96: both hands' joints
 
 // [N, 294] float32 from the hands' parameters (world frame), posed with `models` {left,
 // right} for the joints, and the object states [N, 7].
@@ -35,6 +38,11 @@ at::Tensor mano_representation(const std::array<const HandModel*, 2>& models, co
 // of the two columns). Vertices are not posed.
 HandMotion hands_from_mano_representation(const std::array<const HandModel*, 2>& models, const at::Tensor& rep,
                                           const at::Tensor& states, const std::array<at::Tensor, 2>& shapes);
+
+// The joint columns of MANO-Rep [..., 294] -> [..., 96] (left hand's 16 joints, then the
+// right's), and the column indices they come from (for statistics).
+at::Tensor mano_representation_joints(const at::Tensor& rep);
+const std::vector<std::int64_t>& mano_representation_joint_columns();
 
 // Rotation matrices [..., 3, 3] -> [..., 6] (columns 0 and 1); and back, orthonormalising.
 at::Tensor rotation_to_6d(const at::Tensor& rotations);

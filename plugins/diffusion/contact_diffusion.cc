@@ -5,6 +5,7 @@
 #include <chrono>
 #include <memory>
 
+#include "core/diffusion/model_kind.h"
 #include "core/directing/contact_rules.h"
 #include "core/directing/kept_sample.h"
 #include "core/pipeline/plugin.h"
@@ -32,8 +33,7 @@ class ContactDiffusion : public ContactGenerator {
   }
 
   explicit ContactDiffusion(const Params& p) : s_(diffusion_plugin::read_sampling_params(p)) {
-    if (s_.model->info().network.model != "contact")
-      throw Error(s_.model->path() + " is a " + s_.model->info().network.model + " model, not a contact model");
+    diffusion::check_sampling_stage(s_.model->info(), s_.model->path(), "contact.diffusion");
   }
 
   void run(StageIO& io) override {

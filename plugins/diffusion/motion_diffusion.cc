@@ -8,6 +8,7 @@
 #include <chrono>
 #include <memory>
 
+#include "core/diffusion/model_kind.h"
 #include "core/diffusion/representation.h"
 #include "core/directing/hand_pins.h"
 #include "core/directing/kept_sample.h"
@@ -54,12 +55,7 @@ class MotionDiffusion : public MotionGenerator {
     mano_[0] = p.string("mano_left");
     mano_[1] = p.string("mano_right");
     if (mano_[0].empty() != mano_[1].empty()) throw Error("give both mano_left and mano_right, or neither");
-    if (s_.model->info().network.model != "motion")
-      throw Error(s_.model->path() + " is a " + s_.model->info().network.model + " model, not a motion model");
-    if (s_.model->info().representation != diffusion::kKeypointsRepresentation)
-      throw Error("motion.diffusion samples keypoints X = [H | D], but " + s_.model->path() + " samples " +
-                  diffusion::describe_representation(s_.model->info().representation) +
-                  ": use motion.diffusion_mano for it");
+    diffusion::check_sampling_stage(s_.model->info(), s_.model->path(), "motion.diffusion");
     diffusion::check_compatible(s_.model->info(), s_.model->path(), "motion", "", {},
                                 diffusion::posing_keypoint_ids(), diffusion::kKeypointsRepresentation);
   }

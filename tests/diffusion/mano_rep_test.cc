@@ -97,9 +97,9 @@ TEST(ManoRep, ConfigSwitchSetsTheSampleAndIsRefusedForTheContactModel) {
   EXPECT_HAS(contact, "motion model only");
   EXPECT_HAS(contact, "contact model");
   const std::string other =
-      error_of([&] { load_train_config(write("x.yaml", "model: motion\ndata: d\nout: o\nrepresentation: joints\n")); });
+      error_of([&] { load_train_config(write("x.yaml", "model: motion\ndata: d\nout: o\nrepresentation: fingers\n")); });
   EXPECT_HAS(other, "x.yaml:4");
-  EXPECT_HAS(other, "keypoints or mano");
+  EXPECT_HAS(other, "keypoints, mano or joints");
   // In code: the sample size must agree with the representation.
   TrainConfig c = tiny_mano_config(dir / "run");
   c.network.sample_size = 1200;
@@ -219,15 +219,17 @@ TEST(ManoRep, StagesRefuseTheOtherRepresentationNamingBoth) {
                                           " --pipeline " + kSource + "/pipelines/generate_eval_fit.yaml" +
                                           " --set motion.checkpoint=" + tiny_model().string());
   EXPECT_EQ(exit_code(a), 1) << a.output;
-  EXPECT_HAS(a.output, "motion.diffusion samples keypoints");
-  EXPECT_HAS(a.output, "mano (MANO-Rep)");
+  EXPECT_HAS(a.output, "motion.diffusion cannot sample");
+  EXPECT_HAS(a.output, "it is a MANO-Rep motion model (sampling mano (MANO-Rep)");
+  EXPECT_HAS(a.output, "sampled by motion.diffusion_mano");
   // A keypoint model in motion.diffusion_mano.
   const test::CliRun b = bimart_in_source("generate " + data + " --window 32 --out " + (out / "b").string() +
                                           " --pipeline " + kSource + "/pipelines/generate_eval_mano_rep.yaml" +
                                           " --set motion.checkpoint=" + kSource + "/models/motion.npz");
   EXPECT_EQ(exit_code(b), 1) << b.output;
-  EXPECT_HAS(b.output, "motion.diffusion_mano samples the MANO representation");
-  EXPECT_HAS(b.output, "keypoints (X = [H | D])");
+  EXPECT_HAS(b.output, "motion.diffusion_mano cannot sample");
+  EXPECT_HAS(b.output, "it is the method's motion model (sampling keypoints (X = [H | D])");
+  EXPECT_HAS(b.output, "sampled by motion.diffusion;");
   // Guidance wired into motion.diffusion_mano.
   std::string yaml;
   {
