@@ -20,6 +20,7 @@
 #include "core/io/sequence.h"
 #include "core/object/object_state.h"
 #include "core/object/families/families.h"
+#include "plugins/cams_b/manipulation_stages.h"
 #include "plugins/omomo_b/joint_contact.h"
 #include "tests/cli/run_bimart.h"
 #include "tests/data/tiny_dataset.h"
@@ -223,6 +224,53 @@ TEST(Baselines, JointContactPutsNearJointsOnTheSurfaceAndLeavesFarOnes) {
   EXPECT_TRUE(at::equal(y[0][1].slice(0, 3, 6), x[0][1].slice(0, 3, 6)));  // 20 cm: left alone
   EXPECT_TRUE(at::equal(y[0][0], x[0][0]));                                  // 1 m: left alone
   EXPECT_HAS(error_of([&] { contact.impose(x, 2, 10, 50); }), "outside the 3 frames");
+}
+
+TEST(Baselines, CamsBStagesFollowWhatTheObjectDoesAndHoldTheirMiddleFramesTarget) {
+  // Still 0-9, carried 10-29 (with a 3-frame pause at 18-20), opened 30-49, still 50-59.
+  at::Tensor states = at::zeros({60, 7}, at::kDouble);
+  for (int t = 1; t < 60; ++t) {
+    states[t] = states[t - 1];
+    if (t >= 11 && t <= 30 && !(t >= 19 && t <= 21)) states[t][4] += 0.01;
+    if (t >= 31 && t <= 50) states[t][0] += 0.05;
+  }
+  const auto stages = manipulation_stages(states, 8);
+  ASSERT_EQ(stages.size(), 4u);
+  const std::vector<std::array<std::int64_t, 3>> want{{0, 9, 0}, {10, 29, 1}, {30, 49, 2}, {50, 59, 0}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(stages[k].first, want[k][0]) << k;
+    EXPECT_EQ(stages[k].last, want[k][1]) << k;
+    EXPECT_EQ(stages[k].what, want[k][2]) << k;
+  }
+  EXPECT_EQ(stages_from_tensor(stages_tensor(stages)).back().last, 59);
+  // Targets: each stage's frames hold its middle frame's map.
+  const at::Tensor maps = at::arange(60, at::kFloat).view({60, 1, 1}).expand({60, 2, 4}).contiguous();
+  const at::Tensor t = stage_contact_targets(maps, stages);
+  EXPECT_EQ(t[0][0][0].item<float>(), 4.0f);
+  EXPECT_EQ(t[29][1][3].item<float>(), 19.0f);
+  EXPECT_EQ(t[30][0][0].item<float>(), 39.0f);
+  EXPECT_EQ(t[59][0][0].item<float>(), 54.0f);
+}
+
+TEST(Baselines, CamsBPlacesHandsThroughItsPipelineToSequencesBimartEvalReads) {
+  const fs::path out = scratch("cams_b_run");
+  const test::CliRun r = test::run_bimart(
+      "generate " + testing_data::tiny_dataset().dir.string() + " --samples 2 --window 32 --out " + out.string() +
+      " --pipeline " + kSource + "/pipelines/generate_eval_cams_b.yaml --set contact.sampler=ddim --set contact.steps=3" +
+      " --set refine.rounds=1 --set refine.max_rounds=1 --set refine.steps=5");
+  ASSERT_EQ(exit_code(r), 0) << r.output;
+  EXPECT_HAS(r.output, "motion.cams_b: 1 stages");  // the tiny trajectory is one stage
+  for (const char* folder : {"guided", "refined"}) {
+    const fs::path f = out / folder / "test_d_f024_s01.npz";
+    ASSERT_TRUE(fs::exists(f)) << f;
+    const Sequence s = read_sequence(f.string());
+    EXPECT_EQ(s.num_frames(), 32);
+    EXPECT_TRUE(at::isfinite(s.hands.hands[1].trans).all().item<bool>());
+  }
+  const test::CliRun e = bimart_in_source("eval " + (out / "refined").string());
+  ASSERT_EQ(exit_code(e), 0) << e.output;
+  EXPECT_HAS(e.output, "2 sequences, 1 trajectories");
+  EXPECT_HAS(bimart_in_source("plugins").output, "contact.cams_b");
 }
 
 }  // namespace
