@@ -14,14 +14,11 @@
 #include <memory>
 
 #include "core/diffusion/model_kind.h"
-#include "core/features/hand_features.h"
-#include "core/hand/keypoints.h"
 #include "core/pipeline/plugin.h"
-#include "core/refine/mano_fit.h"
 #include "core/util/log.h"
 #include "manipulation_stages.h"
+#include "plugins/diffusion/mano_samples.h"
 #include "plugins/diffusion/model_params.h"
-#include "plugins/refine/hand_models.h"
 #include "stage_grasps.h"
 #include "stages/contact_generator.h"
 #include "stages/motion_generator.h"
@@ -79,17 +76,12 @@ class CamsHands : public MotionGenerator {
         .param("max_depth", d.max_depth, "m: the planner's deepest hand vertex")
         .input<at::Tensor>("manipulation_stages", "[K, 3] int64 (contact.cams_b)")
         .optional_input<at::Tensor>("contact_maps_samples", "[S, N, 2, 1024]: one stage-wise target per sample")
-        .input<ArticulatedObject>("object", "the two-part object")
-        .input<at::Tensor>("object_states", "[N, 7]")
-        .input<at::Tensor>("basis_hit_indices", "[N, 1024] int64: the object vertex of each target row")
-        .output<at::Tensor>("hand_keypoints_samples", "[S, N, 1200] float32: X of every sample's hands")
-        .output<HandMotion>("hand_params", "sample 0: world frame, β = 0, posed vertices [2, N, V, 3]")
-        .output<std::vector<HandMotion>>("hand_samples", "every sample");
-    refine_plugin::declare_hand_params(s);
+        .input<at::Tensor>("basis_hit_indices", "[N, 1024] int64: the object vertex of each target row");
+    diffusion_plugin::declare_mano_hands(s);
     return s;
   }
 
-  explicit CamsHands(const Params& p) : hands_(refine_plugin::load_hand_pair(p)), samples_(p.integer("samples")) {
+  explicit CamsHands(const Params& p) : hands_(p), samples_(p.integer("samples")) {
     o_.contact = p.number("contact");
     o_.site_radius = p.number("site_radius");
     o_.blend = p.integer("blend");
@@ -97,7 +89,6 @@ class CamsHands : public MotionGenerator {
     if (samples_ < 1 || samples_ > 1024) throw Error("'samples' must be in [1, 1024]");
     if (!(o_.contact > 0) || !(o_.site_radius > 0) || o_.blend < 0 || !(o_.max_depth > 0))
       throw Error("'contact', 'site_radius' and 'max_depth' must be > 0 (m), 'blend' >= 0 (frames)");
-    ids_ = model_keypoints(hands_->models[0]);
   }
 
   void run(StageIO& io) override {
@@ -108,31 +99,22 @@ class CamsHands : public MotionGenerator {
     const auto stages = stages_from_tensor(io.in<at::Tensor>("manipulation_stages"));
     const bool each = io.has("contact_maps_samples") && io.in<at::Tensor>("contact_maps_samples").size(0) == samples_;
     const ObjectDistance distance(object);
-    const auto models = hands_->pointers();
+    const auto models = hands_.hands().pointers();
     std::vector<HandMotion> hands;
-    std::vector<at::Tensor> keypoints;
     for (std::int64_t k = 0; k < samples_; ++k) {
       const at::Tensor targets = each ? io.in<at::Tensor>("contact_maps_samples")[k] : io.in<at::Tensor>("contact_maps");
-      HandMotion h = stage_grasp_hands(object, distance, models, states, targets, io.in<at::Tensor>("basis_hit_indices"),
-                                       stages, o_, io.rng()());
-      h.vertices = pose_hand_vertices(models, h);
-      keypoints.push_back(hand_features(h.vertices, ids_, object, states));
-      hands.push_back(std::move(h));
+      hands.push_back(stage_grasp_hands(object, distance, models, states, targets,
+                                        io.in<at::Tensor>("basis_hit_indices"), stages, o_, io.rng()()));
     }
+    hands_.write_hands(io, std::move(hands));
     log::info("motion.cams_b: {} stages, {} frames x {} samples in {:.2f} s", stages.size(), states.size(0), samples_,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    const at::Tensor X = at::stack(keypoints);
-    io.out("hand_keypoints", X[0].contiguous());
-    io.out("hand_keypoints_samples", X);
-    io.out("hand_params", hands[0]);
-    io.out("hand_samples", std::move(hands));
   }
 
  private:
-  std::shared_ptr<const refine_plugin::HandPair> hands_;
+  diffusion_plugin::ManoHands hands_;
   std::int64_t samples_;
   StageGraspOptions o_;
-  std::vector<int> ids_;
 };
 
 }  // namespace

@@ -1,8 +1,8 @@
-// What every stage that samples MANO-Rep hands writes (motion.diffusion_mano, and the
-// baselines' motion.mdm_b and motion.omomo_hands): the samples [S, N, 294] turned into
-// hands by the hand model (rotations and wrist, β = 0, no keypoint fit), as refine.mano_fit
-// writes them, so every stage after a fit runs unchanged, and the keypoints X of the
-// decoded hands.
+// What every stage that makes MANO hands itself writes (motion.diffusion_mano, and the
+// baselines' motion.mdm_b, motion.omomo_b and motion.cams_b): the hands, as refine.mano_fit
+// writes them, so every stage after a fit runs unchanged, and the keypoints X of the hands.
+// MANO-Rep samples [S, N, 294] are turned into hands by the hand model (rotations and wrist,
+// β = 0, no keypoint fit).
 #pragma once
 
 #include <array>
@@ -46,22 +46,28 @@ class ManoHands {
   void write(StageIO& io, const at::Tensor& M, const std::string& stage,
              std::chrono::steady_clock::time_point t0) const {
     const at::Tensor& states = io.in<at::Tensor>("object_states");
-    const ArticulatedObject& object = io.in<ArticulatedObject>("object");
     if (states.dim() != 2 || states.size(0) != M.size(1))
       throw Error(stage + ": object_states has " + std::to_string(states.dim() == 2 ? states.size(0) : -1) +
                   " frames, the samples " + std::to_string(M.size(1)));
     const auto models = hands_->pointers();
     const std::array<at::Tensor, 2> shapes{at::zeros({HandModel::kNumBetas}), at::zeros({HandModel::kNumBetas})};
     std::vector<HandMotion> hands;
-    std::vector<at::Tensor> keypoints;
-    for (std::int64_t k = 0; k < M.size(0); ++k) {
-      HandMotion h = hands_from_mano_representation(models, M[k], states, shapes);
-      h.vertices = pose_hand_vertices(models, h);
-      keypoints.push_back(hand_features(h.vertices, ids_, object, states));
-      hands.push_back(std::move(h));
-    }
+    for (std::int64_t k = 0; k < M.size(0); ++k) hands.push_back(hands_from_mano_representation(models, M[k], states, shapes));
+    write_hands(io, std::move(hands));
     log::info("{}: {} frames x {} samples in {:.2f} s", stage, M.size(1), M.size(0),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+
+  // Hands in the world frame, one motion per sample -> posed vertices, X and the outputs.
+  void write_hands(StageIO& io, std::vector<HandMotion> hands) const {
+    const at::Tensor& states = io.in<at::Tensor>("object_states");
+    const ArticulatedObject& object = io.in<ArticulatedObject>("object");
+    const auto models = hands_->pointers();
+    std::vector<at::Tensor> keypoints;
+    for (HandMotion& h : hands) {
+      h.vertices = pose_hand_vertices(models, h);
+      keypoints.push_back(hand_features(h.vertices, ids_, object, states));
+    }
     const at::Tensor X = at::stack(keypoints);
     io.out("hand_keypoints", X[0].contiguous());
     io.out("hand_keypoints_samples", X);
