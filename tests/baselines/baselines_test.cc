@@ -32,6 +32,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::error_of;
+using test::exit_code;
 
 #define EXPECT_HAS(haystack, needle) \
   EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "output: " << (haystack)
@@ -45,7 +46,6 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-int exit_code(const test::CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
 test::CliRun bimart_in_source(const std::string& args) { return test::run_bimart("-q " + args); }
 
 // A tiny model of one kind (a few seconds): 3 steps on the tiny data set.

@@ -2,6 +2,8 @@
 // for tests that drive whole commands.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <string>
 
@@ -22,5 +24,8 @@ inline CliRun run_shell(const std::string& command) {
 }
 
 inline CliRun run_bimart(const std::string& args) { return run_shell(std::string(BIMART_CLI) + " " + args); }
+
+// The exit code of a finished run; -1 when it did not exit normally (a signal).
+inline int exit_code(const CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
 
 }  // namespace bimart::test

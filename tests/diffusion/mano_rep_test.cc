@@ -32,6 +32,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::error_of;
+using test::exit_code;
 
 #define EXPECT_HAS(haystack, needle) \
   EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "output: " << (haystack)
@@ -44,8 +45,6 @@ fs::path scratch(const std::string& name) {
   fs::create_directories(dir);
   return dir;
 }
-
-int exit_code(const test::CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
 
 // The CLI in the source tree (the pipelines name models/ and pipelines/ relative to it).
 test::CliRun bimart_in_source(const std::string& args) { return test::run_bimart("-q " + args); }

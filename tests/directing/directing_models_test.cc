@@ -41,8 +41,6 @@ const std::string kSource = BIMART_SOURCE_DIR;
 const std::string kLaptop = "examples/trajectories/laptop_lift_open.yaml";  // 76 frames, the lid opens
 const std::string kBoxLeftFree = "examples/trajectories/box_carry_open_left_free.yaml";  // 166 frames
 
-int exit_code(const test::CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
-
 fs::path scratch() {
   static const fs::path dir = fs::temp_directory_path() / ("bimart_directing_" + std::to_string(::getpid()));
   return dir;

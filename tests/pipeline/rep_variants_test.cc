@@ -33,8 +33,6 @@ namespace {
 #define EXPECT_HAS(haystack, needle) \
   EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "output: " << (haystack)
 
-int exit_code(const test::CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
-
 fs::path scratch() {
   static const fs::path dir = fs::temp_directory_path() / ("bimart_rep_variants_" + std::to_string(::getpid()));
   return dir;

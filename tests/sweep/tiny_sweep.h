@@ -26,8 +26,6 @@ inline tiny_fs::path fresh_scratch_folder(const std::string& prefix) {
   return p;
 }
 
-inline int exit_code(const CliRun& r) { return WIFEXITED(r.status) ? WEXITSTATUS(r.status) : -1; }
-
 inline std::string read_text(const tiny_fs::path& p) {
   std::ifstream in(p);
   std::ostringstream s;
