@@ -23,6 +23,7 @@ namespace {
 
 struct PosingHands {
   std::array<std::string, 2> files;
+  std::shared_ptr<const std::array<HandModel, 2>> models;
   std::array<HandModelTensors, 2> tensors;
   std::array<std::vector<int64_t>, 2> keypoints;
 };
@@ -30,9 +31,9 @@ struct PosingHands {
 std::shared_ptr<const PosingHands> load_posing_hands(const std::array<std::string, 2>& files) {
   auto hands = std::make_shared<PosingHands>();
   hands->files = files;
-  const std::array<HandModel, 2> models = load_hand_models(files[0], files[1]);
+  hands->models = std::make_shared<const std::array<HandModel, 2>>(load_hand_models(files[0], files[1]));
   for (int h = 0; h < 2; ++h) {
-    const HandModel& model = models[static_cast<size_t>(h)];
+    const HandModel& model = (*hands->models)[static_cast<size_t>(h)];
     hands->tensors[h] = HandModelTensors::from(model, at::kFloat);
     std::vector<int> ids;
     try {
@@ -115,6 +116,8 @@ at::Tensor hand_vertices(const HandMotion& motion) {
   }
   return at::stack(per_hand).contiguous();
 }
+
+std::shared_ptr<const std::array<HandModel, 2>> posing_hand_models() { return posing_hands()->models; }
 
 at::Tensor hand_keypoints(const HandMotion& motion) {
   const at::Tensor v = hand_vertices(motion);

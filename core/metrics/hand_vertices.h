@@ -3,10 +3,12 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 
 #include <ATen/core/Tensor.h>
 
+#include "core/hand/hand_model.h"
 #include "core/hand/hand_motion.h"
 
 namespace bimart {
@@ -23,6 +25,8 @@ at::Tensor hand_vertices(const HandMotion& motion);
 void set_posing_hand_models(const std::string& left_npz, const std::string& right_npz);
 // The files hand_vertices poses with now: {left, right}.
 std::array<std::string, 2> posing_hand_model_files();
+// Those models, loaded (shared, loaded once per setting).
+std::shared_ptr<const std::array<HandModel, 2>> posing_hand_models();
 
 // [2, N, J, 3] float32: the J = 100 surface keypoints (the model's keypoint vertex ids)
 // taken from hand_vertices(motion).

@@ -31,7 +31,9 @@ nlohmann::json metrics_json(const MetricsSet& s) {
     j["per_sequence"].push_back({{"file", i < s.files.size() ? s.files[i] : ""}, {"name", m.name}, {"frames", m.frames},
                                  {"accel_cm", number(100 * m.accel)}, {"pen_1cm", count(m.pen_1cm)},
                                  {"pen_5mm", count(m.pen_5mm)}, {"con", count(m.contact)},
-                                 {"art", count(m.articulation)}, {"cm_cm", number(100 * m.contact_map)}});
+                                 {"art", count(m.articulation)}, {"cm_cm", number(100 * m.contact_map)},
+                                 {"pen_3mm", count(m.pen_3mm)}, {"implausible", count(m.implausible)},
+                                 {"implausible_first", m.implausible_first}});
   }
   return j;
 }

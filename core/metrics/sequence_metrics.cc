@@ -8,6 +8,8 @@
 #include "core/metrics/contact.h"
 #include "core/metrics/contact_map_error.h"
 #include "core/metrics/frame_depths.h"
+#include "core/metrics/hand_plausibility.h"
+#include "core/metrics/hand_vertices.h"
 #include "core/metrics/penetration.h"
 #include "core/util/error.h"
 
@@ -34,6 +36,11 @@ SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectD
     ++m.contact_depth_frames;
   }
   m.contact = contact_frames(depths, object_moving_frames(object, d.object_states));
+  // Needs the hand model's vertices (the joints are regressed from them); other point sets
+  // (tests' few points) leave it unmeasured.
+  const auto hands = posing_hand_models();
+  if (d.hand_vertices.size(2) == (*hands)[0].j_regressor.cols())
+    m.implausible = implausible_frames(d.hand_vertices, {&(*hands)[0], &(*hands)[1]}, &m.implausible_first);
   m.articulation = articulation_frames(depths, angle_changing_frames(d.object_states));
   if (d.contact_maps.defined() && d.basis_hit_indices.defined() && d.hand_keypoints.defined())
     m.contact_map = contact_map_error(object, d.object_states, d.basis_hit_indices, d.hand_keypoints,
@@ -118,7 +125,8 @@ std::vector<MetricResult> aggregate_metrics(const std::vector<SequenceMetrics>& 
           contact_depth_result(s),
           frame_share_result("Con", true, s, &SequenceMetrics::contact),
           frame_share_result("Art", true, s, &SequenceMetrics::articulation),
-          contact_map_result(s)};
+          contact_map_result(s),
+          frame_share_result("Implaus", false, s, &SequenceMetrics::implausible)};
 }
 
 }  // namespace bimart

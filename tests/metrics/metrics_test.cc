@@ -143,7 +143,7 @@ TEST(SequenceMetrics, EndToEndOnABoxWithPlacedVertices) {
   EXPECT_EQ(m.contact_depth_frames, 4);
   EXPECT_NEAR(m.contact_depth_sum, 0.033, 1e-9);
   const auto table = aggregate_metrics({m, m}, {0.01, 0.03});
-  ASSERT_EQ(table.size(), 9u);
+  ASSERT_EQ(table.size(), 10u);
   EXPECT_EQ(table[0].name, "Mul");
   EXPECT_NEAR(table[0].value, 2.0, 1e-12);
   EXPECT_EQ(table[2].name, "Pen 1cm");
