@@ -265,6 +265,10 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--w-fit", o.refine.w_fit, "refinement: keypoint weight")->capture_default_str();
   cmd->add_option("--w-hold", o.refine.w_hold, "refinement: hold weight (a hand on the object where it moves; 0 = off)")
       ->capture_default_str();
+  cmd->add_option("--w-limits", o.refine.w_limits, "refinement: anatomical joint-limit weight (0 = off)")
+      ->capture_default_str();
+  cmd->add_option("--fit-w-limits", o.fit.w_limits, "MANO fit: anatomical joint-limit weight (0 = off)")
+      ->capture_default_str();
   cmd->add_option("--pen-exit-depth", o.refine.pen_exit_depth,
                   "refinement: frames deeper than this (m) push inside vertices out towards the rest of the hand (1e9 = off)")
       ->capture_default_str();

@@ -2,6 +2,7 @@
 // every row on the same evaluation windows, and writes the table beside the paper's
 // (core/sweep/, docs/sweeps.md) on this machine or a Slurm cluster (docs/cluster.md).
 // bimart sweep status DIR: what is done, running, left. bimart sweep job DIR KEY: one job.
+#include <algorithm>
 #include <fcntl.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -87,8 +88,9 @@ bool folder_locked(const std::string& dir) {
   return busy;
 }
 
-std::string job_state_text(const Job& job, bool needed) {
+std::string job_state_text(const Job& job, bool needed, bool elsewhere = false) {
   if (is_done(job)) return "done in " + format_duration(read_done(job).value("seconds", 0.0));
+  if (elsewhere) return "done in another sweep";
   if (!needed) return "not needed (what it feeds is done)";
   const Progress p = read_progress(job);
   std::string s = fs::exists(job.folder) ? "started" : "to run";
@@ -116,11 +118,12 @@ std::vector<std::string> split_spaces(const std::string& s) {
   return out;
 }
 
-void print_plan(const Plan& plan, int jobs, int threads) {
+// `elsewhere`: jobs --reuse would take, shown and counted as done.
+void print_plan(const Plan& plan, int jobs, int threads, const std::vector<std::size_t>& elsewhere) {
   const auto rates = read_rates(plan.dir);
   const int per_job = std::max(1, threads / std::max(1, jobs));
   double left = 0;
-  const std::vector<bool> needed = needed_jobs(plan);
+  const std::vector<bool> needed = needed_jobs(plan, elsewhere);
   std::cout << fmt::format("sweep {} ({}): {} jobs in {}\n", plan.name, plan.sweep_file, plan.jobs.size(), plan.dir);
   for (std::size_t i = 0; i < plan.jobs.size(); ++i) {
     const Job& j = plan.jobs[i];
@@ -129,7 +132,10 @@ void print_plan(const Plan& plan, int jobs, int threads) {
     std::string deps;
     for (const auto d : j.deps) deps += (deps.empty() ? "" : ",") + std::to_string(d + 1);
     std::cout << fmt::format("  {:>2}. {:<8} {:<34} {}  {:<28} est. {}{}\n", i + 1, job_kind_name(j.kind), j.name,
-                             j.key, job_state_text(j, needed[i]), format_duration(est),
+                             j.key,
+                             job_state_text(j, needed[i],
+                                            std::find(elsewhere.begin(), elsewhere.end(), i) != elsewhere.end()),
+                             format_duration(est),
                              deps.empty() ? "" : "  after " + deps);
   }
   std::cout << fmt::format("rows:\n");
@@ -162,7 +168,9 @@ int run_sweep(const SweepArgs& a) {
   };
   if (a.dry_run) {
     list_elsewhere("would take");
-    print_plan(plan, a.jobs, threads);
+    std::vector<std::size_t> taken;
+    for (const auto& e : elsewhere) taken.push_back(e.first);
+    print_plan(plan, a.jobs, threads, taken);
     return kExitOk;
   }
   const int lock = lock_folder(dir, a.lock_wait);

@@ -12,6 +12,7 @@
 
 #include "core/geometry/rotation.h"
 #include "core/geometry/point_guard.h"
+#include "core/hand/joint_limits.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs_subset.h"
 #include "core/hand/lbs_torch.h"
@@ -61,6 +62,25 @@ struct PosePriorCost {
     return true;
   }
 };
+
+// Anatomical joint limits: ℓ_f · (angle beyond its range) · √(w_limits · J), 45 per frame.
+struct JointLimitCost {
+  const JointLimits* limits;
+  double scale;
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    for (int j = 0; j < 15; ++j) {
+      limits->excess(j, x + 3 + 3 * j, r + 3 * j);
+      for (int c = 0; c < 3; ++c) r[3 * j + c] *= scale;
+    }
+    return true;
+  }
+};
+
+ceres::CostFunction* joint_limit_cost(const JointLimits& limits, double w_limits) {
+  return new ceres::AutoDiffCostFunction<JointLimitCost, HandModel::kPoseDim, kX>(
+      new JointLimitCost{&limits, std::sqrt(w_limits * kJ) * kLeverFinger});
+}
 
 struct ShapePriorCost {
   double scale;  // √(w_shape · J · N) · ℓ_β
@@ -132,6 +152,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   beta->assign(kB, 0.0);
   const double* mean = model.hands_mean.data();
   const double prior_scale = std::sqrt(opt.w_pose * kJ) * kLeverFinger;
+  const JointLimits limits(model);
 
   auto palm_points = [&](const double* v300) {
     Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(palm.size()));
@@ -158,6 +179,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
       p.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePriorCost, HandModel::kPoseDim, kX>(
                              new PosePriorCost{prior_scale, mean}),
                          nullptr, x);
+      if (opt.w_limits > 0) p.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
       p.SetParameterBlockConstant(beta->data());
       ceres::Solver::Summary s;
       solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
@@ -172,6 +194,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PosePriorCost, HandModel::kPoseDim, kX>(
                                  new PosePriorCost{prior_scale, mean}),
                              nullptr, x);
+    if (opt.w_limits > 0) problem.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
     if (t > 0)
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SmoothCost, kX, kX, kX>(
                                    new SmoothCost{std::sqrt(opt.w_smooth * kJ)}),
@@ -183,6 +206,9 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   if (!opt.fit_shape) problem.SetParameterBlockConstant(beta->data());
   ceres::Solver::Summary summary;
   solve(&problem, opt.max_iterations, sparse_solver(), &summary);
+  // What the penalty leaves outside a range goes onto its edge (core/hand/joint_limits.h).
+  if (opt.w_limits > 0)
+    for (int64_t t = 0; t < N; ++t) limits.clamp_pose(states->data() + t * kX + 3);
 
   double err = 0;
   for (int64_t t = 0; t < N; ++t) {
@@ -212,6 +238,7 @@ void ManoFitOptions::validate() const {
   nonneg(w_pose, "w_pose");
   nonneg(w_shape, "w_shape");
   nonneg(w_smooth, "w_smooth");
+  nonneg(w_limits, "w_limits");
   if (warm_start_iterations < 0) throw Error("mano fit: warm_start_iterations must be >= 0");
   if (max_iterations < 0) throw Error("mano fit: max_iterations must be >= 0");
   if (threads < 0) throw Error("mano fit: threads must be >= 0 (0 = all cores)");

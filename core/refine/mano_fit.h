@@ -7,9 +7,13 @@
 //   + w_pose   · J · Σ_t ||ℓ_f (pose_t − mean pose)||²        weak pose prior
 //   + w_shape  · J · N · ||ℓ_β β||²                           weak shape prior
 //   + w_smooth · J · Σ_t ||ℓ ⊙ (θ_t − θ_{t−1})||²             temporal smoothness
+//   + w_limits · J · Σ_t ||ℓ_f · excess(pose_t)||²            anatomical joint limits (ours)
 // with lever arms ℓ turning angles into lengths (ℓ_rot = 0.1 m for the wrist, ℓ_f = 0.03 m
 // for the fingers, 1 for translation, ℓ_β = 0.01 m per unit of β), and J = 100 keypoints,
-// so a weight of 1 makes a term count like the keypoints do.
+// so a weight of 1 makes a term count like the keypoints do. excess() is each finger joint's
+// flexion, abduction and twist beyond its anatomical range (core/hand/joint_limits.h): 0
+// inside, so the limits change nothing a plausible hand does; after the solve every joint
+// still outside its range is clamped onto it (JointLimits::clamp).
 //
 // Solve: frame 0 from a rigid alignment of the palm keypoints (Umeyama) at the mean pose;
 // every next frame warm-started from its neighbour's solution (moved rigidly onto the
@@ -34,6 +38,8 @@ struct ManoFitOptions {
   double w_pose = 1e-3;    // pose prior towards MANO's mean finger pose
   double w_shape = 1e-3;   // shape prior towards β = 0
   double w_smooth = 1e-2;  // first differences of θ between frames
+  // Joint limits: a joint 1° beyond its range costs as much as all 100 keypoints 5 mm off.
+  double w_limits = 100;
   bool fit_shape = true;   // false: β stays 0
   int warm_start_iterations = 3;  // per frame, sequentially
   int max_iterations = 30;        // the joint solve

@@ -16,6 +16,7 @@
 
 #include "core/features/hand_features.h"
 #include "core/geometry/point_guard.h"
+#include "core/hand/joint_limits.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
 #include "core/hand/lbs_subset.h"
@@ -30,6 +31,7 @@ namespace {
 
 constexpr int kJ = 100;
 constexpr int kX = kHandStateSize;
+constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
 using Jet = ceres::Jet<double, kX>;
 
 struct Plane {
@@ -71,7 +73,36 @@ struct HandData {
   std::vector<RefineDirections::Pin> pins;
   Eigen::Vector3d j0 = Eigen::Vector3d::Zero();
   double s_pin = 0;
+  std::optional<JointLimits> limits;  // the model's; residual scale √(2 w_limits / N) · ℓ_f
+  double s_limits = 0;
 };
+
+// One finger's anatomical joint limits in one frame: its three joints' excess (9 angles).
+struct FingerLimitCost {
+  const JointLimits* limits;
+  int finger;
+  double scale;
+  template <class T>
+  bool operator()(const T* pose9, T* r) const {
+    for (int k = 0; k < 3; ++k) {
+      limits->excess(3 * finger + k, pose9 + 3 * k, r + 3 * k);
+      for (int c = 0; c < 3; ++c) r[3 * k + c] *= scale;
+    }
+    return true;
+  }
+};
+
+// Σ_t Σ_j ||excess||² (rad²) of the hand's current poses.
+double limit_excess_sum(const HandData& d) {
+  double sum = 0;
+  for (int64_t t = 0; t < d.N; ++t)
+    for (int j = 0; j < 15; ++j) {
+      double r[3];
+      d.limits->excess(j, d.x.data() + t * kX + 3 + 3 * j, r);
+      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    }
+  return sum;
+}
 
 // Poses every frame once per evaluation point, with Jacobians when asked.
 class PoseCache : public ceres::EvaluationCallback {
@@ -490,6 +521,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   e.terms.fit = o.w_fit * fit / nk;
   e.terms.hold = o.w_hold * hold / static_cast<double>(N);
   e.terms.pin = pin_cost(*d, w_pin);
+  e.terms.limits = o.w_limits * kLeverFinger * kLeverFinger * limit_excess_sum(*d) / static_cast<double>(N);
   e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
   e.keypoint_error = kerr / nk;
   return e;
@@ -519,6 +551,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   d->s_pen = std::sqrt(2 * o.w_pen / nk);
   d->s_hold = std::sqrt(2 * o.w_hold / static_cast<double>(d->N));
   d->s_pin = std::sqrt(2 * w_pin);
+  d->s_limits = std::sqrt(2 * o.w_limits / static_cast<double>(d->N)) * kLeverFinger;
   for (int p : d->hold_part) rep->held_frames += p >= 0;
   d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
@@ -552,6 +585,11 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         const std::vector<Block> blocks = blocks_of(masks[static_cast<size_t>(d->kp_ids[static_cast<size_t>(f.hold_k)])]);
         problem.AddResidualBlock(new HoldCost(d, t, blocks), nullptr, block_pointers(x, blocks));
       }
+      if (o.w_limits > 0)
+        for (int g = 0; g < 5; ++g)
+          problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FingerLimitCost, 9, 9>(
+                                       new FingerLimitCost{&*d->limits, g, d->s_limits}),
+                                   nullptr, x + 3 + 9 * g);
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {
         const std::vector<Block> blocks = blocks_of(mask);
@@ -608,6 +646,12 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
       rows += static_cast<size_t>(f.sub.size());
       pens += f.pen_rows.size();
     }
+    // The limits as a constraint: the penalty steers, and every joint the solve left outside
+    // its range is put back on its edge (a stiffer penalty makes Levenberg–Marquardt reject
+    // the steps that cross it and stall, with the penetration boost growing behind it).
+    if (o.w_limits > 0)
+      for (int64_t t = 0; t < d->N; ++t)
+        if (d->kept.empty() || !d->kept[static_cast<size_t>(t)]) rep->clamped_joints += d->limits->clamp_pose(d->x.data() + t * kX + 3);
     rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
     ++rep->outer_iterations;
     e = timed_evaluate(true, true);
@@ -701,6 +745,7 @@ void RefineOptions::validate() const {
   nonneg(w_acc, "w_acc");
   nonneg(w_fit, "w_fit");
   nonneg(w_hold, "w_hold");
+  nonneg(w_limits, "w_limits");
   nonneg(pen_margin, "pen_margin");
   if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
@@ -734,6 +779,7 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
   for (int h = 0; h < 2; ++h) {
     HandData& d = data[static_cast<size_t>(h)];
     d.model = models[static_cast<size_t>(h)];
+    d.limits.emplace(*d.model);
     d.N = N;
     states_from_hand_motion(start, h, &d.x, &d.beta);
     d.H = as_vector(w.positions[h]);
@@ -761,10 +807,10 @@ std::string format_refine_report(const RefineReport& r) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
         "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}, "
-        "hold {:.3g} -> {:.3g} ({} frames); "
+        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped); "
         "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
-        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
         x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;

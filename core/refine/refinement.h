@@ -8,6 +8,8 @@
 //   w_acc  · mean_{t,a} ||v_ta − 2 v_t−1,a + v_t−2,a||²  second differences of hand vertices
 //   w_fit  · mean_{t,k} ||K_tk − Ĥ_tk||²                 keypoints near the prediction (ours)
 //   w_hold · Σ_{t held} max(0, −sd(K_t*))² / N           a hand on the object where it must be (ours)
+//   w_limits · Σ_{t,j} ||0.03 m · excess_tj||² / N       anatomical joint limits (ours; core/hand/joint_limits.h),
+//                                                         with every joint clamped into its range after each round
 // The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
 // converges, so it squares them and adds the fit term to hold what the other terms leave
 // free (a contact constrains a keypoint along the surface normal only). Its weights
@@ -72,6 +74,13 @@ struct RefineOptions {
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
   double w_hold = 0;           // the hold term (ours; 0 = off, the paper's)
+  // Joint limits (ours, off by default): a joint 1° beyond its range costs about as much as
+  // a frame whose every keypoint is 1 cm off its prediction (w_fit), and after every round
+  // each joint still outside is clamped to its range (JointLimits::clamp); 0 = neither (the
+  // paper's). Measured (docs/refinement.md): with 1e4, hands stay anatomical but keep out
+  // of the object less well — Levenberg–Marquardt stalls on the penalty's edge — so the
+  // default waits for joint angles as bounded parameters.
+  double w_limits = 0;
   void validate() const;       // throws bimart::Error naming the option
 };
 
@@ -106,8 +115,8 @@ struct RefineDirections {
 
 // The terms of the cost as defined above, weighted, with exact surface distances.
 struct RefineTerms {
-  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0;
-  double total() const { return proj + pen + acc + fit + hold + pin; }
+  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0, limits = 0;
+  double total() const { return proj + pen + acc + fit + hold + pin + limits; }
 };
 struct RefineHandReport {
   RefineTerms before, after;
@@ -117,6 +126,7 @@ struct RefineHandReport {
   int outer_iterations = 0;
   double max_pen_boost = 1;                          // largest weight multiplier reached
   int held_frames = 0;                               // frames this hand was held in
+  int clamped_joints = 0;                            // joints put back into their ranges, all rounds
   double seconds = 0;
   double surface_seconds = 0;  // of which: surface queries and linearisation
 };

@@ -88,13 +88,14 @@ void adopt_finished(const Plan& plan, const std::vector<std::pair<std::size_t, s
   }
 }
 
-std::vector<bool> needed_jobs(const Plan& plan) {
+std::vector<bool> needed_jobs(const Plan& plan, const std::vector<std::size_t>& done_elsewhere) {
   const std::size_t n = plan.jobs.size();
   std::vector<std::vector<std::size_t>> dependents(n);
   for (std::size_t i = 0; i < n; ++i)
     for (const std::size_t d : plan.jobs[i].deps) dependents.at(d).push_back(i);
   std::vector<bool> done(n), needed(n, false);
   for (std::size_t i = 0; i < n; ++i) done[i] = is_done(plan.jobs[i]);
+  for (const std::size_t i : done_elsewhere) done.at(i) = true;
   // Jobs come dependencies first, so dependents are decided before the jobs they need.
   for (std::size_t k = n; k-- > 0;) {
     if (done[k]) continue;

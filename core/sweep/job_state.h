@@ -25,7 +25,8 @@ bool is_done(const Job& job);
 // Which jobs still have to run: those not done that a result needs. A finished
 // evaluation needs neither its samples nor its models any more, so a sweep folder whose
 // bulky outputs were deleted (or never copied) reruns nothing that is not missing.
-std::vector<bool> needed_jobs(const Plan& plan);
+// `done_elsewhere`: indices of jobs counted as done too (those --reuse would take).
+std::vector<bool> needed_jobs(const Plan& plan, const std::vector<std::size_t>& done_elsewhere = {});
 
 // Jobs finished in another sweep's folder (`--reuse DIR`): train and eval jobs of `plan` not
 // done in its own folder whose folder under one of `sweeps` (the same relative path, so the

@@ -46,6 +46,8 @@ class CeresRefineStage : public Refiner {
             .param("w_hold", d.w_hold,
                    "where the object moves (the hinge turns) and no hand touches it (its top part), the nearer hand "
                    "is pulled onto it (ours; 0 = off, the paper's)")
+            .param("w_limits", d.w_limits,
+                   "anatomical finger-joint limits (ours; 0 = off, the paper's): core/hand/joint_limits.h")
             .param("w_pin", RefineDirections{}.w_pin,
                    "pinned wrists, orientations and poses (docs/directing.md): weight per pinned frame")
             .optional_input<HandConstraints>("hand_constraints",
@@ -70,6 +72,7 @@ class CeresRefineStage : public Refiner {
     o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));
     o_.threads = static_cast<int>(p.integer("threads"));
     o_.w_hold = p.number("w_hold");
+    o_.w_limits = p.number("w_limits");
     o_.validate();
     w_pin_ = p.number("w_pin");
     if (!(w_pin_ >= 0)) throw Error("'w_pin' must be >= 0");

@@ -21,6 +21,7 @@ class ManoFitStage : public Refiner {
                       .param("w_pose", d.w_pose, "weak prior towards MANO's mean finger pose")
                       .param("w_shape", d.w_shape, "weak prior towards β = 0")
                       .param("w_smooth", d.w_smooth, "temporal smoothness: first differences of θ")
+                      .param("w_limits", d.w_limits, "anatomical finger-joint limits (0: off)")
                       .param("fit_shape", d.fit_shape, "fit β (false: β = 0)")
                       .param("warm_start_iterations", d.warm_start_iterations, "solver steps per frame, frame by frame")
                       .param("max_iterations", d.max_iterations, "solver steps of the joint solve over all frames")
@@ -33,6 +34,7 @@ class ManoFitStage : public Refiner {
     o_.w_pose = p.number("w_pose");
     o_.w_shape = p.number("w_shape");
     o_.w_smooth = p.number("w_smooth");
+    o_.w_limits = p.number("w_limits");
     o_.fit_shape = p.boolean("fit_shape");
     o_.warm_start_iterations = static_cast<int>(p.integer("warm_start_iterations"));
     o_.max_iterations = static_cast<int>(p.integer("max_iterations"));

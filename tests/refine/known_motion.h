@@ -2,12 +2,14 @@
 // shipped models, and their keypoints with Gaussian noise.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
 
 #include <ATen/ATen.h>
 
+#include "core/hand/joint_limits.h"
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
 
@@ -21,10 +23,14 @@ inline HandMotion known_motion(const std::array<const HandModel*, 2>& models, in
   for (int h = 0; h < 2; ++h) {
     std::vector<double> a(51), b(51), phase(51);
     for (int i = 0; i < 51; ++i) {
-      a[i] = i < 3 ? 0.8 * g(rng) : (i < 48 ? models[h]->hands_mean[i - 3] + 0.2 * g(rng) : 0.05 * g(rng));
-      b[i] = i < 48 ? 0.15 * g(rng) : 0.02 * g(rng);
+      // Fingers: the mean pose, a little noise, and each joint's curl swinging by ±40 %,
+      // inside the anatomical limits (core/hand/joint_limits.h) as a real hand is.
+      const double mean = i >= 3 && i < 48 ? models[h]->hands_mean[i - 3] : 0.0;
+      a[i] = i < 3 ? 0.8 * g(rng) : (i < 48 ? mean + 0.04 * g(rng) : 0.05 * g(rng));
+      b[i] = i < 3 ? 0.15 * g(rng) : (i < 48 ? 0.4 * mean : 0.02 * g(rng));
       phase[i] = 6.28 * std::uniform_real_distribution<double>(0, 1)(rng);
     }
+    for (int i = 3; i < 48; ++i) phase[i] = phase[3 + 9 * ((i - 3) / 9)];  // a finger curls as one
     a[48] += h == 0 ? -0.1 : 0.1;
     states[h].resize(static_cast<size_t>(N) * 51);
     for (int t = 0; t < N; ++t)
@@ -51,6 +57,19 @@ inline at::Tensor noisy_keypoints(const std::array<const HandModel*, 2>& models,
     H = H + at::normal(0.0, sigma_mm * 1e-3, H.sizes(), gen, at::TensorOptions().dtype(at::kDouble));
   }
   return H.to(at::kFloat);
+}
+
+// The largest angle (degrees) by which a joint of either hand in any frame of `motion`
+// leaves its anatomical range (core/hand/joint_limits.h).
+inline double largest_joint_excess(const std::array<const HandModel*, 2>& models, const HandMotion& motion) {
+  double worst = 0;
+  for (int h = 0; h < 2; ++h) {
+    const JointLimits limits(*models[h]);
+    const at::Tensor pose = motion.hands[h].pose.to(at::kDouble).contiguous();
+    for (int64_t t = 0; t < pose.size(0); ++t)
+      worst = std::max(worst, limits.largest_excess(Eigen::Map<const Eigen::VectorXd>(pose[t].data_ptr<double>(), 45)));
+  }
+  return worst;
 }
 
 }  // namespace bimart::test

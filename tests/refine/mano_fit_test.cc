@@ -48,6 +48,35 @@ TEST(ManoFit, ExactKeypointsFitToWellUnderAMillimetre) {
   EXPECT_LT((fit.vertices - truth.vertices).norm(2, {3}).mean().item<double>(), 0.0005);
 }
 
+// Keypoints of hands whose index and middle fingers are bent 70° backwards at the PIP and
+// twisted 40° at the MCP (a diffusion model's worst): the fit keeps every joint within its
+// anatomical range; without the limits it follows the keypoints out of them.
+TEST(ManoFit, KeepsEveryJointWithinItsRangeOnCorruptedKeypoints) {
+  const auto& models = test::shipped_hands();
+  const int N = 6;
+  HandMotion bent = test::known_motion(models, N, /*seed=*/5);
+  for (int h = 0; h < 2; ++h) {
+    const JointLimits L(*models[h]);
+    at::Tensor pose = bent.hands[h].pose.to(at::kDouble).contiguous();
+    for (int t = 0; t < N; ++t)
+      for (int finger : {0, 1}) {
+        double* p = pose[t].data_ptr<double>() + 9 * finger;
+        const Eigen::Vector3d pip_axis = Eigen::Vector3d(p[3], p[4], p[5]).normalized();  // mostly flexion
+        for (int k = 0; k < 3; ++k) p[3 + k] = -70.0 * M_PI / 180 * pip_axis[k];
+        p[0] += 0.7;  // about 40° more about x: a twist and a sideways bend at the MCP
+      }
+    bent.hands[h].pose = pose.to(at::kFloat);
+  }
+  bent.vertices = pose_hand_vertices(models, bent);
+  const at::Tensor H = test::noisy_keypoints(models, bent, 0.0, 0);
+  const auto worst = [&](const HandMotion& m) { return test::largest_joint_excess(models, m); };
+  EXPECT_GT(worst(bent), 40.0);
+  EXPECT_LT(worst(fit_mano(models, H)), 1e-3);  // degrees; the motion's poses are float32
+  ManoFitOptions off;
+  off.w_limits = 0;
+  EXPECT_GT(worst(fit_mano(models, H, off)), 20.0);
+}
+
 TEST(ManoFit, RejectsBadInput) {
   const auto& models = test::shipped_hands();
   EXPECT_THROW(fit_mano(models, at::zeros({2, 4, 99, 3})), Error);
@@ -56,6 +85,9 @@ TEST(ManoFit, RejectsBadInput) {
   EXPECT_THROW(fit_mano(models, H), Error);
   ManoFitOptions bad;
   bad.w_smooth = -1;
+  EXPECT_THROW(fit_mano(models, at::zeros({2, 4, 100, 3}), bad), Error);
+  bad.w_smooth = 0;
+  bad.w_limits = -1;
   EXPECT_THROW(fit_mano(models, at::zeros({2, 4, 100, 3}), bad), Error);
 }
 

@@ -32,6 +32,13 @@ ArticulatedObject slab() {
   return o;
 }
 
+// Hand features X of keypoints H [2, N, 100, 3] (rows 0..99 are the keypoints).
+at::Tensor keypoint_features(const at::Tensor& H, const ArticulatedObject& object, const at::Tensor& states) {
+  std::vector<int> ids(100);
+  for (int i = 0; i < 100; ++i) ids[i] = i;
+  return hand_features(H, ids, object, states);
+}
+
 // Both hands lying flat on z = 0 (the thinnest direction of each flat hand turned to z),
 // 1 mm above it, side by side; N identical frames.
 HandMotion hands_on_the_slab(const std::array<const HandModel*, 2>& models, int N) {
@@ -204,11 +211,7 @@ TEST(Refinement, AJitterySequenceComesOutSmoother) {
   at::Tensor H = test::noisy_keypoints(models, truth, 1.0, 22);
   at::Generator gen = at::detail::createCPUGenerator(23);
   H = H + at::normal(0.0, 0.004, {2, N, 1, 3}, gen);  // the whole hand jumps, frame to frame
-  const at::Tensor X = hand_features(H, [] {
-    std::vector<int> ids(100);
-    for (int i = 0; i < 100; ++i) ids[i] = i;
-    return ids;
-  }(), object, states);
+  const at::Tensor X = keypoint_features(H, object, states);
   const HandMotion fit = fit_mano(models, H);
   RefineReport report;
   const HandMotion refined = refine_hands(models, distance, states, X, fit, {}, &report);
@@ -219,6 +222,32 @@ TEST(Refinement, AJitterySequenceComesOutSmoother) {
   EXPECT_LT(a_ref, 0.5 * a_fit);
   const double err = (refined.vertices - truth.vertices).norm(2, {3}).mean().item<double>();
   EXPECT_LT(err, 0.004);
+}
+
+// With w_limits the refinement hands back every joint within its range, even from a
+// start whose fingers are bent backwards (the fit's limits off); without, they stay out.
+TEST(Refinement, WithLimitsEveryJointEndsWithinItsRange) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 6;
+  HandMotion start = test::known_motion(models, N, 31);
+  for (auto& p : start.hands) {
+    p.trans = p.trans + at::tensor({0.0f, 0.0f, 0.3f});
+    p.pose.select(1, 4).fill_(-1.2f);  // index PIP about x: far outside
+  }
+  start.vertices = pose_hand_vertices(models, start);
+  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
+  const at::Tensor H = test::noisy_keypoints(models, start, 0.0, 0);
+  const at::Tensor X = keypoint_features(H, object, states);
+  const auto worst = [&](const HandMotion& m) { return test::largest_joint_excess(models, m); };
+  EXPECT_GT(worst(start), 20.0);
+  RefineOptions on, off;
+  on.w_limits = 1e4;
+  RefineReport report;
+  EXPECT_LT(worst(refine_hands(models, distance, states, X, start, on, &report)), 1e-3);  // float32 poses
+  EXPECT_GT(report.hands[0].clamped_joints + report.hands[1].clamped_joints, 0);
+  EXPECT_GT(worst(refine_hands(models, distance, states, X, start, off)), 20.0);
 }
 
 TEST(Refinement, RejectsMismatchedInput) {
