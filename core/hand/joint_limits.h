@@ -59,6 +59,22 @@ class JointLimits {
   // 0 inside. Templated for Ceres' Jets.
   template <class T>
   void excess(int j, const T* aa, T* r) const;
+  // excess() of joints first .. first + count − 1 (their axis-angles consecutive in aa),
+  // each residual times `scale`: 3·count residuals, for the fit's and the refinement's costs.
+  template <class T>
+  void scaled_excess(int first, int count, const T* aa, double scale, T* r) const {
+    for (int k = 0; k < count; ++k) {
+      excess(first + k, aa + 3 * k, r + 3 * k);
+      for (int c = 0; c < 3; ++c) r[3 * k + c] *= scale;
+    }
+  }
+  // Σ of the squared excesses (rad²) of a finger pose [45].
+  double squared_excess(const double* pose) const {
+    double r[45], sum = 0;
+    scaled_excess(0, 15, pose, 1.0, r);
+    for (const double v : r) sum += v * v;
+    return sum;
+  }
   // Flexion (thumb: swing), abduction and twist of joint j at aa, degrees.
   Eigen::Vector3d angles(int j, const Eigen::Vector3d& aa) const;
   // Joint j's rotation moved into its ranges: flexion (thumb: swing), abduction and twist

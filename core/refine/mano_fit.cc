@@ -69,10 +69,7 @@ struct JointLimitCost {
   double scale;
   template <class T>
   bool operator()(const T* x, T* r) const {
-    for (int j = 0; j < 15; ++j) {
-      limits->excess(j, x + 3 + 3 * j, r + 3 * j);
-      for (int c = 0; c < 3; ++c) r[3 * j + c] *= scale;
-    }
+    limits->scaled_excess(0, 15, x + 3, scale, r);
     return true;
   }
 };

@@ -84,10 +84,7 @@ struct FingerLimitCost {
   double scale;
   template <class T>
   bool operator()(const T* pose9, T* r) const {
-    for (int k = 0; k < 3; ++k) {
-      limits->excess(3 * finger + k, pose9 + 3 * k, r + 3 * k);
-      for (int c = 0; c < 3; ++c) r[3 * k + c] *= scale;
-    }
+    limits->scaled_excess(3 * finger, 3, pose9, scale, r);
     return true;
   }
 };
@@ -95,12 +92,7 @@ struct FingerLimitCost {
 // Σ_t Σ_j ||excess||² (rad²) of the hand's current poses.
 double limit_excess_sum(const HandData& d) {
   double sum = 0;
-  for (int64_t t = 0; t < d.N; ++t)
-    for (int j = 0; j < 15; ++j) {
-      double r[3];
-      d.limits->excess(j, d.x.data() + t * kX + 3 + 3 * j, r);
-      sum += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    }
+  for (int64_t t = 0; t < d.N; ++t) sum += d.limits->squared_excess(d.x.data() + t * kX + 3);
   return sum;
 }
 
