@@ -267,6 +267,12 @@ void add_refine_commands(CLI::App& app, Commands& out) {
       ->capture_default_str();
   cmd->add_option("--w-limits", o.refine.w_limits, "refinement: anatomical joint-limit weight (0 = off)")
       ->capture_default_str();
+  cmd->add_option("--joint-angles", o.refine.joint_angles,
+                  "refinement: finger joints as angles bounded by their ranges (false: axis-angles, the paper's)")
+      ->capture_default_str();
+  cmd->add_option("--backtrack", o.refine.backtrack,
+                  "refinement: cut back a round's step in frames it took deeper into the object (false: the paper's)")
+      ->capture_default_str();
   cmd->add_option("--fit-w-limits", o.fit.w_limits, "MANO fit: anatomical joint-limit weight (0 = off)")
       ->capture_default_str();
   cmd->add_option("--pen-exit-depth", o.refine.pen_exit_depth,

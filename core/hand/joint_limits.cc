@@ -57,6 +57,25 @@ Eigen::Vector3d JointLimits::angles(int j, const Eigen::Vector3d& aa) const {
   return out / kRad;
 }
 
+Eigen::Vector3d JointLimits::parameters(int j, const Eigen::Vector3d& aa) const {
+  if (j < 0 || j >= 15) throw Error("joint limits: joint " + std::to_string(j) + " is not a finger joint (0..14)");
+  const Frame& f = frames_[static_cast<std::size_t>(j)];
+  Eigen::Vector3d b, angle;
+  ceres::AngleAxisRotatePoint(aa.data(), f.d.data(), b.data());
+  raw_angles(j, aa.data(), angle.data());  // the twist
+  const double along = b.dot(f.d), side = b.dot(f.a), palm = b.dot(f.ad);
+  return {std::atan2(palm, along), std::atan2(side, std::hypot(along, palm)), angle[2]};
+}
+
+std::array<AngleRange, 3> JointLimits::bounds(int j) const {
+  const Frame& f = frames_.at(static_cast<std::size_t>(j));
+  const JointLimit& L = f.limit;
+  // Abduction within ±90°: beyond, (flex, abd) and (flex ± π, ±π − abd) are one bone.
+  const double abduct = std::min(L.flex.hi, M_PI / 2);
+  if (f.thumb) return {AngleRange{-L.flex.hi, L.flex.hi}, AngleRange{-abduct, abduct}, L.twist};
+  return {L.flex, L.abduct, L.twist};
+}
+
 bool JointLimits::clamp(int j, Eigen::Vector3d* aa) const {
   const Frame& f = frames_.at(static_cast<std::size_t>(j));
   Eigen::Vector3d angle;

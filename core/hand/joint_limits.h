@@ -75,6 +75,21 @@ class JointLimits {
     for (const double v : r) sum += v * v;
     return sum;
   }
+  // Joint j's rotation as three angles (radians), the refinement's bounded parameters: the
+  // bone turned by flexion about a towards the palm and by abduction towards a,
+  //   d' = cos(abd) (cos(flex) d + sin(flex) a×d) + sin(abd) a,
+  // the rotation the shortest swing from d onto d' after a twist about d. For the fingers
+  // flexion, abduction and twist are exactly those angles() reads; for the thumb flexion and
+  // abduction are the two components of its swing. parameters() is rotation()'s inverse
+  // for any rotation whose swing is under π.
+  template <class T>
+  void rotation(int j, const T* angle, T* aa) const;
+  Eigen::Vector3d parameters(int j, const Eigen::Vector3d& aa) const;
+  // The box rotation()'s angles are kept in (radians): the ranges for the fingers; for the
+  // thumb ±its largest swing M on flexion and abduction (abduction at most ±90°; cos swing = cos flex · cos abd, so
+  // for M ≥ 90° the box lies inside the range; below, its corners reach acos(cos² M):
+  // 80° → 88°, which excess() and clamp() see to) and its twist range.
+  std::array<AngleRange, 3> bounds(int j) const;
   // Flexion (thumb: swing), abduction and twist of joint j at aa, degrees.
   Eigen::Vector3d angles(int j, const Eigen::Vector3d& aa) const;
   // Joint j's rotation moved into its ranges: flexion (thumb: swing), abduction and twist
@@ -145,6 +160,31 @@ void JointLimits::raw_angles(int j, const T* aa, T* angle) const {
     c = -c;
   }
   angle[2] = T(2) * atan2(s * w_d, c);
+}
+
+template <class T>
+void JointLimits::rotation(int j, const T* angle, T* aa) const {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const Frame& f = frames_[static_cast<std::size_t>(j)];
+  const T cf = cos(angle[0]), sf = sin(angle[0]), ca = cos(angle[1]), sa = sin(angle[1]);
+  T b[3];  // d'
+  for (int i = 0; i < 3; ++i) b[i] = ca * (cf * f.d[i] + sf * f.ad[i]) + sa * f.a[i];
+  // The swing's quaternion (1 + d·d', d × d') normalised: w = cos(φ/2), v = d×d' / (2w).
+  const T c = b[0] * f.d[0] + b[1] * f.d[1] + b[2] * f.d[2];
+  const T w = sqrt((T(1) + c) / T(2));
+  const T v[3] = {(f.d[1] * b[2] - f.d[2] * b[1]) / (T(2) * w), (f.d[2] * b[0] - f.d[0] * b[2]) / (T(2) * w),
+                  (f.d[0] * b[1] - f.d[1] * b[0]) / (T(2) * w)};
+  // Times the twist (cos(τ/2), sin(τ/2) d); v ⊥ d, so the product's w is w·cos(τ/2).
+  const T ct = cos(angle[2] / T(2)), st = sin(angle[2] / T(2));
+  T q[4];
+  q[0] = w * ct;
+  for (int i = 0; i < 3; ++i) q[1 + i] = v[i] * ct + w * st * f.d[i];
+  q[1] += (v[1] * f.d[2] - v[2] * f.d[1]) * st;
+  q[2] += (v[2] * f.d[0] - v[0] * f.d[2]) * st;
+  q[3] += (v[0] * f.d[1] - v[1] * f.d[0]) * st;
+  ceres::QuaternionToAngleAxis(q, aa);
 }
 
 template <class T>

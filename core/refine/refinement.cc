@@ -75,16 +75,49 @@ struct HandData {
   double s_pin = 0;
   std::optional<JointLimits> limits;  // the model's; residual scale √(2 w_limits / N) · ℓ_f
   double s_limits = 0;
+  // What Ceres optimises, [N × 51]: x itself, or with RefineOptions::joint_angles x with
+  // each finger joint's axis-angle as its three bounded angles (JointLimits::rotation).
+  bool angles = false;
+  std::vector<double> p;
+  bool is_kept(int64_t t) const { return !kept.empty() && kept[static_cast<size_t>(t)]; }
 };
 
-// One finger's anatomical joint limits in one frame: its three joints' excess (9 angles).
+// Frame state x (axis-angles) from parameters p, templated for Jets; and back.
+template <class T>
+void state_of(const HandData& d, const T* p, T* x) {
+  if (!d.angles) {
+    std::copy(p, p + kX, x);
+    return;
+  }
+  std::copy(p, p + 3, x);
+  std::copy(p + 48, p + kX, x + 48);
+  for (int j = 0; j < 15; ++j) d.limits->rotation(j, p + 3 + 3 * j, x + 3 + 3 * j);
+}
+void params_of(const HandData& d, const double* x, double* p) {
+  std::copy(x, x + kX, p);
+  if (!d.angles) return;
+  for (int j = 0; j < 15; ++j) {
+    const Eigen::Vector3d a = d.limits->parameters(j, Eigen::Vector3d(x[3 + 3 * j], x[4 + 3 * j], x[5 + 3 * j]));
+    std::copy(a.data(), a.data() + 3, p + 3 + 3 * j);
+  }
+}
+
+// One finger's anatomical joint limits in one frame: its three joints' excess, from their
+// parameters (axis-angles, or bounded angles).
 struct FingerLimitCost {
   const JointLimits* limits;
   int finger;
   double scale;
+  bool angles;
   template <class T>
-  bool operator()(const T* pose9, T* r) const {
-    limits->scaled_excess(3 * finger, 3, pose9, scale, r);
+  bool operator()(const T* p9, T* r) const {
+    T aa[9];
+    for (int k = 0; k < 3; ++k)
+      if (angles)
+        limits->rotation(3 * finger + k, p9 + 3 * k, aa + 3 * k);
+      else
+        std::copy(p9 + 3 * k, p9 + 3 * k + 3, aa + 3 * k);
+    limits->scaled_excess(3 * finger, 3, aa, scale, r);
     return true;
   }
 };
@@ -96,7 +129,8 @@ double limit_excess_sum(const HandData& d) {
   return sum;
 }
 
-// Poses every frame once per evaluation point, with Jacobians when asked.
+// Poses every frame once per evaluation point (x from the parameters p), with Jacobians
+// (with respect to p) when asked.
 class PoseCache : public ceres::EvaluationCallback {
  public:
   explicit PoseCache(HandData* d) : d_(d) {}
@@ -104,12 +138,15 @@ class PoseCache : public ceres::EvaluationCallback {
     if (!new_point && (have_jacobians_ || !jacobians)) return;
     for (int64_t t = 0; t < d_->N; ++t) {
       FrameTerms& f = d_->frames[static_cast<size_t>(t)];
-      const double* x = d_->x.data() + t * kX;
+      double* x = d_->x.data() + t * kX;
+      const double* p = d_->p.data() + t * kX;
+      if (!d_->is_kept(t)) state_of(*d_, p, x);
       const int R = 3 * f.sub.size();
       f.pos.resize(static_cast<size_t>(R));
       if (jacobians) {
-        Jet xj[kX];
-        for (int i = 0; i < kX; ++i) xj[i] = Jet(x[i], i);
+        Jet pj[kX], xj[kX];
+        for (int i = 0; i < kX; ++i) pj[i] = Jet(p[i], i);
+        state_of(*d_, pj, xj);
         std::vector<Jet> out(static_cast<size_t>(R));
         lbs_subset(f.sub, xj, xj + 3, xj + 48, d_->beta.data(), out.data());
         f.jac.resize(static_cast<size_t>(R) * kX);
@@ -519,6 +556,104 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   return e;
 }
 
+// With bounded joint angles, the angles each round holds (SubsetManifold): the passive ones —
+// every joint's twist and the PIP's and DIP's abduction stay as the fit set them (free, the
+// solver turns them to their edges, ±20°, to slip vertices out, and converges slower:
+// docs/refinement.md) — and, as an active-set method would, those on an edge that the
+// cost's gradient pushes outwards (Ceres keeps bounds by projecting each step onto the box:
+// a step computed as if such a joint could go on is cut there, Levenberg–Marquardt rejects
+// it and shrinks its region, and the round stalls).
+void hold_angles(ceres::Problem* problem, const HandData& d) {
+  std::vector<double*> blocks;
+  for (int64_t t = 0; t < d.N; ++t)
+    for (int g = 0; g < 5; ++g) {
+      double* b = const_cast<double*>(d.p.data()) + t * kX + 3 + 9 * g;
+      if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) blocks.push_back(b);
+    }
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = blocks;
+  double cost = 0;
+  std::vector<double> gradient;
+  problem->Evaluate(eo, &cost, nullptr, &gradient, nullptr);
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    std::vector<int> held;
+    for (int i = 0; i < 9; ++i) {
+      const double x = blocks[b][i], g = gradient[9 * b + static_cast<size_t>(i)];
+      const double lo = problem->GetParameterLowerBound(blocks[b], i), hi = problem->GetParameterUpperBound(blocks[b], i);
+      constexpr double kEdge = 1e-9;  // rad
+      const bool passive = i % 3 == 2 || i == 4 || i == 7;  // a twist, or a PIP's or DIP's abduction
+      if (passive || (x <= lo + kEdge && g > 0) || (x >= hi - kEdge && g < 0)) held.push_back(i);
+    }
+    if (held.size() == 9)
+      problem->SetParameterBlockConstant(blocks[b]);
+    else if (!held.empty())
+      problem->SetManifold(blocks[b], new ceres::SubsetManifold(9, held));
+  }
+}
+
+// The surface enters each round linearised, and a step can carry vertices past planes they
+// had none of (a finger curled 70° into the part it touched). So each frame whose deepest
+// vertex (exact distance, beyond its clearance) would end deeper than it started and than
+// the tolerance takes half its step, a quarter, or none; the cut fades in and out over
+// kFade frames each side (a minimum, then a mean: never more than a frame's own share), so
+// the motion stays smooth (cut frame by frame, Accel rose 0.044 → 0.289 on generated
+// samples); a frame the faded share still takes too deep takes none. Kept and pinned frames
+// keep their step. Returns the frames cut back.
+int backtrack(HandData* d, const LbsSubset& all, const ObjectDistance& dist, const RefineOptions& o,
+              const std::vector<double>& p_before) {
+  constexpr int64_t kFade = 3;
+  const int64_t N = d->N;
+  std::vector<bool> fixed(static_cast<size_t>(N), false);
+  for (int64_t t = 0; t < N; ++t) fixed[static_cast<size_t>(t)] = d->is_kept(t);
+  for (const RefineDirections::Pin& p : d->pins) fixed[static_cast<size_t>(p.frame)] = true;
+  std::vector<double> x(kX), p(kX), limit(static_cast<size_t>(N), 0.0), share(static_cast<size_t>(N), 1.0);
+  // Frame t's parameters a share of the way from the round's start to the solver's point.
+  const auto blend = [&](int64_t t, double a) {
+    const double *pb = p_before.data() + t * kX, *pt = d->p.data() + t * kX;
+    for (int i = 0; i < kX; ++i) p[static_cast<size_t>(i)] = pb[i] + a * (pt[i] - pb[i]);
+    return p.data();
+  };
+  const auto depth = [&](int64_t t, const double* params) {
+    state_of(*d, params, x.data());
+    return dist.max_signed_distance(d->states[static_cast<size_t>(t)], pose_all(all, x.data(), d->beta.data())) +
+           d->clearance[static_cast<size_t>(t)];
+  };
+  bool any = false;
+  for (int64_t t = 0; t < N; ++t) {
+    if (fixed[static_cast<size_t>(t)]) continue;
+    limit[static_cast<size_t>(t)] = std::max(depth(t, p_before.data() + t * kX), o.pen_tolerance);
+    for (const double a : {1.0, 0.5, 0.25, 0.0})
+      if (a == 0.0 || depth(t, blend(t, a)) <= limit[static_cast<size_t>(t)]) {
+        share[static_cast<size_t>(t)] = a;
+        any |= a < 1.0;
+        break;
+      }
+  }
+  if (!any) return 0;
+  std::vector<double> low(static_cast<size_t>(N)), faded(static_cast<size_t>(N));
+  for (int64_t t = 0; t < N; ++t) {
+    low[static_cast<size_t>(t)] = 1.0;
+    for (int64_t u = std::max<int64_t>(0, t - kFade); u <= std::min(N - 1, t + kFade); ++u)
+      low[static_cast<size_t>(t)] = std::min(low[static_cast<size_t>(t)], share[static_cast<size_t>(u)]);
+  }
+  for (int64_t t = 0; t < N; ++t) {
+    double sum = 0;
+    int n = 0;
+    for (int64_t u = std::max<int64_t>(0, t - kFade); u <= std::min(N - 1, t + kFade); ++u, ++n) sum += low[static_cast<size_t>(u)];
+    faded[static_cast<size_t>(t)] = sum / n;
+  }
+  int cut = 0;
+  for (int64_t t = 0; t < N; ++t) {
+    double a = faded[static_cast<size_t>(t)];
+    if (fixed[static_cast<size_t>(t)] || a >= 1.0) continue;
+    if (depth(t, blend(t, a)) > limit[static_cast<size_t>(t)]) a = 0.0;
+    std::copy(blend(t, a), blend(t, a) + kX, d->p.data() + t * kX);
+    state_of(*d, d->p.data() + t * kX, d->x.data() + t * kX);
+    ++cut;
+  }
+  return cut;
+}
+
 void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o, RefineHandReport* rep,
                  double w_pin) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -552,6 +687,8 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   const int max_outer = std::max(o.outer_iterations, o.max_outer_iterations);
   for (int outer = 0; outer < max_outer; ++outer) {
     if (outer >= o.outer_iterations && (e.max_depth <= o.pen_tolerance || o.w_pen == 0)) break;
+    d->p.resize(d->x.size());
+    for (int64_t t = 0; t < d->N; ++t) params_of(*d, d->x.data() + t * kX, d->p.data() + t * kX);
     PoseCache cache(d);
     ceres::Problem::Options po;
     po.evaluation_callback = &cache;
@@ -567,7 +704,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
       for (size_t i = 0; i < f.pen_rows.size(); ++i)
         groups[masks[static_cast<size_t>(f.sub.vertex_ids[static_cast<size_t>(f.pen_rows[i])])]].second.push_back(
             static_cast<int>(i));
-      double* x = d->x.data() + t * kX;
+      double* x = d->p.data() + t * kX;
       for (auto& [mask, g] : groups) {
         const std::vector<Block> blocks = blocks_of(mask);
         problem.AddResidualBlock(new FrameCost(d, t, blocks, std::move(g.first), std::move(g.second)), nullptr,
@@ -577,54 +714,75 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         const std::vector<Block> blocks = blocks_of(masks[static_cast<size_t>(d->kp_ids[static_cast<size_t>(f.hold_k)])]);
         problem.AddResidualBlock(new HoldCost(d, t, blocks), nullptr, block_pointers(x, blocks));
       }
-      if (o.w_limits > 0)
-        for (int g = 0; g < 5; ++g)
+      if (o.w_limits > 0)  // with bounded angles, only the thumb's box corners can be outside
+        for (int g = d->angles ? 4 : 0; g < 5; ++g)
           problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FingerLimitCost, 9, 9>(
-                                       new FingerLimitCost{&*d->limits, g, d->s_limits}),
+                                       new FingerLimitCost{&*d->limits, g, d->s_limits, d->angles}),
                                    nullptr, x + 3 + 9 * g);
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {
         const std::vector<Block> blocks = blocks_of(mask);
         std::vector<double*> p;
         for (int64_t u = t - 2; u <= t; ++u)
-          for (double* q : block_pointers(d->x.data() + u * kX, blocks)) p.push_back(q);
+          for (double* q : block_pointers(d->p.data() + u * kX, blocks)) p.push_back(q);
         problem.AddResidualBlock(new AccelCost(d, t, blocks, rows), nullptr, p);
       }
     }
+    // A pinned frame's fingers: their target as parameters, which its bounds then include.
+    std::map<int64_t, std::vector<double>> pinned_fingers;
     for (const RefineDirections::Pin& p : d->pins) {
-      double* x = d->x.data() + p.frame * kX;
+      double* x = d->p.data() + p.frame * kX;
       const Eigen::Vector3d trans = p.wrist - d->j0;
       problem.AddResidualBlock(new ValuePinCost<3>(trans.data(), d->s_pin), nullptr, x + 48);
       if (p.rotation)
         problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPin, 3, 3>(new RotationPin{*p.rotation, d->s_pin}),
                                  nullptr, x);
-      if (p.fingers)
+      if (p.fingers) {
+        std::vector<double> target(kX, 0.0);
+        std::copy(p.fingers->data(), p.fingers->data() + 45, target.data() + 3);
+        params_of(*d, std::vector<double>(target).data(), target.data());
         for (int g = 0; g < 5; ++g)
-          problem.AddResidualBlock(new ValuePinCost<9>(p.fingers->data() + 9 * g, d->s_pin), nullptr, x + 3 + 9 * g);
+          problem.AddResidualBlock(new ValuePinCost<9>(target.data() + 3 + 9 * g, d->s_pin), nullptr, x + 3 + 9 * g);
+        pinned_fingers[p.frame] = std::move(target);
+      }
     }
     // Kept frames stay as they started: every block of theirs constant.
     for (int64_t t = 0; t < d->N; ++t) {
-      if (d->kept.empty() || !d->kept[static_cast<size_t>(t)]) continue;
-      double* x = d->x.data() + t * kX;
+      if (!d->is_kept(t)) continue;
+      double* x = d->p.data() + t * kX;
       for (const Block& b : blocks_of(0x1f))
         if (problem.HasParameterBlock(x + b.offset)) problem.SetParameterBlockConstant(x + b.offset);
     }
     // Bounds keep a hand that the penetration boost pushes hard from winding its joints
     // round and round (generated keypoints 5 cm deep once drove a finger angle to 1,100 rad):
-    // each finger axis-angle component within ±π, the root's within ±2π.
+    // the root's axis-angle within ±2π; the fingers' angles within their ranges
+    // (JointLimits::bounds; a pinned frame's widened to its pin), or their axis-angle
+    // components within ±π.
     for (int64_t t = 0; t < d->N; ++t) {
-      if (!d->kept.empty() && d->kept[static_cast<size_t>(t)]) continue;
-      double* x = d->x.data() + t * kX;
+      if (d->is_kept(t)) continue;
+      double* x = d->p.data() + t * kX;
+      const auto pin = pinned_fingers.find(t);
       for (const Block& b : blocks_of(0x1f)) {
         if (b.offset == 48 || !problem.HasParameterBlock(x + b.offset)) continue;  // translation: free
-        const double bound = b.offset == 0 ? 2 * M_PI : M_PI;
         for (int i = 0; i < b.size; ++i) {
-          x[b.offset + i] = std::clamp(x[b.offset + i], -bound, bound);
-          problem.SetParameterLowerBound(x + b.offset, i, -bound);
-          problem.SetParameterUpperBound(x + b.offset, i, bound);
+          const int k = b.offset + i;  // in the 51-vector
+          double lo = b.offset == 0 ? -2 * M_PI : -M_PI, hi = -lo;
+          if (b.offset > 0 && d->angles) {
+            const AngleRange r = d->limits->bounds((k - 3) / 3)[static_cast<size_t>((k - 3) % 3)];
+            lo = r.lo;
+            hi = r.hi;
+            if (pin != pinned_fingers.end()) {
+              lo = std::min(lo, pin->second[static_cast<size_t>(k)]);
+              hi = std::max(hi, pin->second[static_cast<size_t>(k)]);
+            }
+          }
+          x[k] = std::clamp(x[k], lo, hi);
+          problem.SetParameterLowerBound(x + b.offset, i, lo);
+          problem.SetParameterUpperBound(x + b.offset, i, hi);
         }
       }
     }
+    if (d->angles) hold_angles(&problem, *d);
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     so.max_num_iterations = o.max_iterations;
@@ -632,7 +790,11 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     so.logging_type = ceres::SILENT;
     so.function_tolerance = 1e-8;
     ceres::Solver::Summary summary;
+    const std::vector<double> p_before = d->p;
     ceres::Solve(so, &problem, &summary);
+    for (int64_t t = 0; t < d->N; ++t)  // the state at the solution (the cache may hold a rejected step's)
+      if (!d->is_kept(t)) state_of(*d, d->p.data() + t * kX, d->x.data() + t * kX);
+    if (o.backtrack) rep->backtracked_frames += backtrack(d, all, dist, o, p_before);
     size_t rows = 0, pens = 0;
     for (const FrameTerms& f : d->frames) {
       rows += static_cast<size_t>(f.sub.size());
@@ -641,9 +803,9 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     // The limits as a constraint: the penalty steers, and every joint the solve left outside
     // its range is put back on its edge (a stiffer penalty makes Levenberg–Marquardt reject
     // the steps that cross it and stall, with the penetration boost growing behind it).
-    if (o.w_limits > 0)
+    if (o.w_limits > 0 || d->angles)
       for (int64_t t = 0; t < d->N; ++t)
-        if (d->kept.empty() || !d->kept[static_cast<size_t>(t)]) rep->clamped_joints += d->limits->clamp_pose(d->x.data() + t * kX + 3);
+        if (!d->is_kept(t) && !pinned_fingers.count(t)) rep->clamped_joints += d->limits->clamp_pose(d->x.data() + t * kX + 3);
     rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
     ++rep->outer_iterations;
     e = timed_evaluate(true, true);
@@ -772,6 +934,7 @@ HandMotion refine_hands(const std::array<const HandModel*, 2>& models, const Obj
     HandData& d = data[static_cast<size_t>(h)];
     d.model = models[static_cast<size_t>(h)];
     d.limits.emplace(*d.model);
+    d.angles = options.joint_angles;
     d.N = N;
     states_from_hand_motion(start, h, &d.x, &d.beta);
     d.H = as_vector(w.positions[h]);
@@ -799,10 +962,10 @@ std::string format_refine_report(const RefineReport& r) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
         "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}, "
-        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped); "
+        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped); {} steps cut back; "
         "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
-        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
         x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;

@@ -48,6 +48,10 @@ class CeresRefineStage : public Refiner {
                    "is pulled onto it (ours; 0 = off, the paper's)")
             .param("w_limits", d.w_limits,
                    "anatomical finger-joint limits (ours; 0 = off, the paper's): core/hand/joint_limits.h")
+            .param("joint_angles", d.joint_angles,
+                   "finger joints as angles bounded by their anatomical ranges (ours; false: axis-angles, the paper's)")
+            .param("backtrack", d.backtrack,
+                   "cut back a round's step in frames it took deeper into the object (ours; false: the paper's)")
             .param("w_pin", RefineDirections{}.w_pin,
                    "pinned wrists, orientations and poses (docs/directing.md): weight per pinned frame")
             .optional_input<HandConstraints>("hand_constraints",
@@ -73,6 +77,8 @@ class CeresRefineStage : public Refiner {
     o_.threads = static_cast<int>(p.integer("threads"));
     o_.w_hold = p.number("w_hold");
     o_.w_limits = p.number("w_limits");
+    o_.joint_angles = p.boolean("joint_angles");
+    o_.backtrack = p.boolean("backtrack");
     o_.validate();
     w_pin_ = p.number("w_pin");
     if (!(w_pin_ >= 0)) throw Error("'w_pin' must be >= 0");

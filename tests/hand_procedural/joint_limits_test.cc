@@ -134,6 +134,59 @@ TEST(JointLimits, ClampMovesAJointOntoItsRangeAndNoFurther) {
   }
 }
 
+// The refinement's angles: rotation() and parameters() are inverses, the fingers' angles
+// are those angles() reads, every rotation inside the box is inside the ranges (up to the
+// thumb's 80° corners, which clamp() takes), and rotation()'s Jets match numeric derivatives.
+TEST(JointLimits, BoundedAnglesRoundTripAndStayInsideTheRanges) {
+  using Jet = ceres::Jet<double, 3>;
+  for (int side : {0, 1}) {
+    const JointLimits L(hand(side));
+    std::mt19937 rng(11 + side);
+    std::uniform_real_distribution<double> unit(0.0, 1.0), u(-2.5, 2.5);
+    for (int trial = 0; trial < 300; ++trial) {
+      const int j = trial % 15;
+      const auto box = L.bounds(j);
+      Eigen::Vector3d angle;
+      for (int c = 0; c < 3; ++c) angle[c] = box[c].lo + unit(rng) * (box[c].hi - box[c].lo);
+      Eigen::Vector3d aa;
+      L.rotation(j, angle.data(), aa.data());
+      EXPECT_LT((L.parameters(j, aa) - angle).norm(), 1e-9) << "joint " << j;
+      if (j < 12) {
+        EXPECT_LT((L.angles(j, aa) - angle * kDeg).norm(), 1e-7) << "joint " << j;
+        double r[3];
+        L.excess(j, aa.data(), r);
+        EXPECT_LT(Eigen::Vector3d(r[0], r[1], r[2]).norm(), 1e-9) << "joint " << j;
+      } else if (j != 13) {  // the thumb's CMC (90°) and IP (95°): the box is inside the disc
+        EXPECT_LE(L.angles(j, aa)[0], box[0].hi * kDeg + 1e-7) << "joint " << j;
+      }
+      // Any rotation under π round-trips (as a rotation) through parameters().
+      Eigen::Vector3d any(u(rng), u(rng), u(rng));
+      if (any.norm() > 3.0) any *= 3.0 / any.norm();
+      const Eigen::Vector3d p = L.parameters(j, any);
+      Eigen::Vector3d back;
+      L.rotation(j, p.data(), back.data());
+      const Eigen::Quaterniond qa(Eigen::AngleAxisd(any.norm(), any.normalized())),
+          qb(Eigen::AngleAxisd(back.norm(), back.normalized()));
+      EXPECT_GT(std::abs(qa.dot(qb)), 1 - 1e-10) << "joint " << j;
+      // Jets against central differences.
+      const Jet x[3] = {Jet(angle[0], 0), Jet(angle[1], 1), Jet(angle[2], 2)};
+      Jet r[3];
+      L.rotation(j, x, r);
+      for (int q = 0; q < 3; ++q) {
+        constexpr double h = 1e-6;
+        Eigen::Vector3d lo = angle, hi = angle, rl, rh;
+        lo[q] -= h;
+        hi[q] += h;
+        L.rotation(j, lo.data(), rl.data());
+        L.rotation(j, hi.data(), rh.data());
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(r[c].v[q], (rh[c] - rl[c]) / (2 * h), 1e-6) << "joint " << j;
+      }
+    }
+    // The rest pose is the origin of the angles.
+    for (int j = 0; j < 15; ++j) EXPECT_LT(L.parameters(j, Eigen::Vector3d::Zero()).norm(), 1e-12);
+  }
+}
+
 TEST(JointLimits, JetDerivativesMatchNumericOnes) {
   using Jet = ceres::Jet<double, 3>;
   const JointLimits L(hand(1));

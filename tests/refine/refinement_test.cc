@@ -224,8 +224,9 @@ TEST(Refinement, AJitterySequenceComesOutSmoother) {
   EXPECT_LT(err, 0.004);
 }
 
-// With w_limits the refinement hands back every joint within its range, even from a
-// start whose fingers are bent backwards (the fit's limits off); without, they stay out.
+// The refinement hands back every joint within its range, even from a start whose fingers
+// are bent backwards (the fit's limits off): with bounded joint angles (the default), and
+// with axis-angles and w_limits' penalty and clamp; with neither, they stay out.
 TEST(Refinement, WithLimitsEveryJointEndsWithinItsRange) {
   const auto& models = test::shipped_hands();
   const ArticulatedObject object = slab();
@@ -242,10 +243,12 @@ TEST(Refinement, WithLimitsEveryJointEndsWithinItsRange) {
   const at::Tensor X = keypoint_features(H, object, states);
   const auto worst = [&](const HandMotion& m) { return test::largest_joint_excess(models, m); };
   EXPECT_GT(worst(start), 20.0);
-  RefineOptions on, off;
-  on.w_limits = 1e4;
+  RefineOptions bounded, penalty, off;
+  bounded.joint_angles = true;
+  penalty.w_limits = 1e4;
+  EXPECT_LT(worst(refine_hands(models, distance, states, X, start, bounded)), 1e-3);  // float32 poses
   RefineReport report;
-  EXPECT_LT(worst(refine_hands(models, distance, states, X, start, on, &report)), 1e-3);  // float32 poses
+  EXPECT_LT(worst(refine_hands(models, distance, states, X, start, penalty, &report)), 1e-3);
   EXPECT_GT(report.hands[0].clamped_joints + report.hands[1].clamped_joints, 0);
   EXPECT_GT(worst(refine_hands(models, distance, states, X, start, off)), 20.0);
 }
