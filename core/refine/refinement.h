@@ -86,8 +86,8 @@ struct RefineOptions {
   // anatomical ranges, so every step stays inside them (the thumb's box corners, outside its
   // swing, are clamped after each round); twists and PIP/DIP abductions keep the fit's
   // values. false: the axis-angles, within ±π (the paper's). Measured (docs/refinement.md):
-  // Implaus halves, but hands leave the object less well (Pen 5mm 0.5 → 2.7 %) and the
-  // refinement takes about twice as long.
+  // on generated samples Implaus 98 → 48 %, but hands leave the object less well (Pen 1cm
+  // 0.16 → 8.2 %) and less smoothly (Accel 0.043 → 0.133).
   bool joint_angles = false;
   // Steps checked against the exact surface (ours, off by default): the surface is
   // linearised per round, and a step can carry vertices past planes they had none of. After
@@ -95,7 +95,7 @@ struct RefineOptions {
   // pen_tolerance takes half its step, a quarter, or none, faded over 3 frames each side
   // (pinned and kept frames excepted). Measured (docs/refinement.md): on corrupted ground
   // truth Pen 5mm 1.0 → 0.5 %; on generated samples it holds back frames that needed their
-  // step (Pen 1cm 0.2 → 2.9 %, Accel 0.044 → 0.137), so it stays off.
+  // step (Pen 1cm 0.16 → 2.9 %, Accel 0.043 → 0.137), so it stays off.
   bool backtrack = false;
   void validate() const;       // throws bimart::Error naming the option
 };
