@@ -647,7 +647,8 @@ int backtrack(HandData* d, const LbsSubset& all, const ObjectDistance& dist, con
     double a = faded[static_cast<size_t>(t)];
     if (fixed[static_cast<size_t>(t)] || a >= 1.0) continue;
     if (depth(t, blend(t, a)) > limit[static_cast<size_t>(t)]) a = 0.0;
-    std::copy(blend(t, a), blend(t, a) + kX, d->p.data() + t * kX);
+    const double* q = blend(t, a);
+    std::copy(q, q + kX, d->p.data() + t * kX);
     state_of(*d, d->p.data() + t * kX, d->x.data() + t * kX);
     ++cut;
   }
