@@ -64,9 +64,14 @@ std::string implausibility(const Eigen::Matrix<double, 16, 3>& J, const Eigen::M
     }
     const V3 meta = (p[0] - base).normalized();  // wrist to knuckle
     const V3 b0 = (p[1] - p[0]).normalized(), b1 = (p[2] - p[1]).normalized(), b2 = (p[3] - p[2]).normalized();
+    // Abduction: the bone's angle out of its flexion plane (the plane through the metacarpal
+    // and the palm normal). Read about the palm normal instead, it is ill-conditioned for a
+    // finger flexed towards the palm (80° flexion with 10° of abduction read 45°).
+    const V3 across = (palm.cross(meta)).normalized();
+    const double abduction = std::asin(std::clamp(b0.dot(across), -1.0, 1.0)) * kDeg;
     for (const std::string& why :
          {outside(name, "MCP", "flexion", turn_about(meta, b0, flex_axis), L.mcp_flex),
-          outside(name, "MCP", "abduction", turn_about(meta, b0, palm), L.mcp_abduct),
+          outside(name, "MCP", "abduction", abduction, L.mcp_abduct),
           outside(name, "PIP", "flexion", turn_about(b0, b1, flex_axis), L.pip_flex),
           outside(name, "DIP", "flexion", turn_about(b1, b2, flex_axis), L.dip_flex)})
       if (!why.empty()) return why;

@@ -4,7 +4,7 @@
 // nothing but the vertices every metric uses, and it does not depend on how the pose was
 // parameterised.
 //   Bends: at each finger's MCP, PIP and DIP joint the flexion (about the hand's lateral
-//   axis, + towards the palm) and at the MCP the abduction (about the palm normal), from
+//   axis, + towards the palm) and at the MCP the abduction (out of the flexion plane), from
 //   the bones' directions; the thumb's MCP and IP bends unsigned. The ranges (degrees,
 //   kFingerLimits) are the ranges of motion usually quoted for the fingers (flexion MCP
 //   0-90, PIP 0-110, DIP 0-90, MCP hyperextension to about 30, abduction about 20-30;

@@ -86,7 +86,7 @@ struct RefineOptions {
   // anatomical ranges, so every step stays inside them (the thumb's box corners, outside its
   // swing, are clamped after each round); twists and PIP/DIP abductions keep the fit's
   // values. false: the axis-angles, within ±π (the paper's). Measured (docs/refinement.md):
-  // on generated samples Implaus 98 → 48 %, but hands leave the object less well (Pen 1cm
+  // on generated samples Implaus 98 → 37 %, but hands leave the object less well (Pen 1cm
   // 0.16 → 8.2 %) and less smoothly (Accel 0.043 → 0.133).
   bool joint_angles = false;
   // Steps checked against the exact surface (ours, off by default): the surface is

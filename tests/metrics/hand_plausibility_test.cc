@@ -53,6 +53,18 @@ TEST(HandPlausibility, FlatHandAndAGraspPassBentBackAndCrossedFingersDoNot) {
     // ... and 60° forwards is fine.
     const Posed fwd = pose(h, with_joint(h, 2, Eigen::Vector3d(0, 0, 1.05)));
     EXPECT_EQ(implausibility(fwd.joints, fwd.tips, h), "") << h;
+    // The index MCP flexed 80° towards the palm with 12° of abduction is fine (read about the
+    // palm normal, as the measure first did, it read 45°, on the range's edge); spread 60° in the
+    // palm's plane is not.
+    const auto turned = [](double flex_deg, double abduct_deg) {
+      const Eigen::AngleAxisd r(Eigen::AngleAxisd(flex_deg * M_PI / 180, Eigen::Vector3d::UnitZ()) *
+                                Eigen::AngleAxisd(abduct_deg * M_PI / 180, Eigen::Vector3d::UnitY()));
+      return Eigen::Vector3d(r.angle() * r.axis());
+    };
+    const Posed flexed = pose(h, with_joint(h, 1, turned(80, 12)));
+    EXPECT_EQ(implausibility(flexed.joints, flexed.tips, h), "") << h;
+    const Posed spread = pose(h, with_joint(h, 1, turned(0, 60)));
+    EXPECT_NE(implausibility(spread.joints, spread.tips, h).find("index MCP abduction"), std::string::npos) << h;
     // Index and middle spread 20° towards each other at their MCP (within the abduction
     // range each): they cross.
     Eigen::VectorXd cross = with_joint(h, 1, Eigen::Vector3d(0, -0.35, 0));
