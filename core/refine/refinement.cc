@@ -563,11 +563,11 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
 // cost's gradient pushes outwards (Ceres keeps bounds by projecting each step onto the box:
 // a step computed as if such a joint could go on is cut there, Levenberg–Marquardt rejects
 // it and shrinks its region, and the round stalls).
-void hold_angles(ceres::Problem* problem, const HandData& d) {
+void hold_angles(ceres::Problem* problem, HandData* d) {
   std::vector<double*> blocks;
-  for (int64_t t = 0; t < d.N; ++t)
+  for (int64_t t = 0; t < d->N; ++t)
     for (int g = 0; g < 5; ++g) {
-      double* b = const_cast<double*>(d.p.data()) + t * kX + 3 + 9 * g;
+      double* b = d->p.data() + t * kX + 3 + 9 * g;
       if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) blocks.push_back(b);
     }
   ceres::Problem::EvaluateOptions eo;
@@ -739,9 +739,9 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RotationPin, 3, 3>(new RotationPin{*p.rotation, d->s_pin}),
                                  nullptr, x);
       if (p.fingers) {
-        std::vector<double> target(kX, 0.0);
-        std::copy(p.fingers->data(), p.fingers->data() + 45, target.data() + 3);
-        params_of(*d, std::vector<double>(target).data(), target.data());
+        std::vector<double> state(kX, 0.0), target(kX);
+        std::copy(p.fingers->data(), p.fingers->data() + 45, state.data() + 3);
+        params_of(*d, state.data(), target.data());
         for (int g = 0; g < 5; ++g)
           problem.AddResidualBlock(new ValuePinCost<9>(target.data() + 3 + 9 * g, d->s_pin), nullptr, x + 3 + 9 * g);
         pinned_fingers[p.frame] = std::move(target);
@@ -783,7 +783,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         }
       }
     }
-    if (d->angles) hold_angles(&problem, *d);
+    if (d->angles) hold_angles(&problem, d);
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     so.max_num_iterations = o.max_iterations;
