@@ -154,7 +154,7 @@ void print_table(const std::vector<SetResult>& sets) {
     for (size_t c = 0; c < cols.size(); ++c) row += fmt::format("{:>{}}", cell(s.table[c]), width[c]);
     std::cout << row << "\n";
   }
-  std::cout << "units: Mul cm, Accel cm/frame², Pen/Con/Art % of frames (passing/considered), Depth mm (mean over contact frames), CM cm, Implaus % of frames; "
+  std::cout << "units: Mul cm, Accel cm/frame², Pen/Con/Art % of frames (passing/considered), Depth mm (mean over contact frames), CM cm, Implaus and Cavity % of frames; "
                "'-' = nothing to measure\n";
   for (const auto& s : sets)
     std::cout << fmt::format("{}: {} sequences, {} trajectories, {} with several samples (Mul){}\n", s.label,

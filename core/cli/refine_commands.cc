@@ -273,6 +273,8 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--backtrack", o.refine.backtrack,
                   "refinement: cut back a round's step in frames it took deeper into the object (false: the paper's)")
       ->capture_default_str();
+  cmd->add_option("--w-pose", o.refine.w_pose, "refinement: finger pose held near the fit's (0 = off)")
+      ->capture_default_str();
   cmd->add_option("--fit-w-limits", o.fit.w_limits, "MANO fit: anatomical joint-limit weight (0 = off)")
       ->capture_default_str();
   cmd->add_option("--pen-exit-depth", o.refine.pen_exit_depth,

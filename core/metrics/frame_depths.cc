@@ -14,6 +14,9 @@
 namespace bimart {
 namespace {
 
+// m: cavity depths up to this read 0 (only Cavity's 1 cm threshold reads them).
+constexpr double kCavityFloor = 0.005;
+
 // Diverged motion (NaN, or absurdly far) is reported with its frame, hand and vertex
 // before any of it reaches CGAL.
 void check_frame_points(const Points3& pts, int64_t v, int64_t t) {
@@ -45,6 +48,7 @@ FrameDepths frame_depths(const ObjectDistance& distance, const at::Tensor& state
   FrameDepths out;
   out.top.assign(static_cast<size_t>(n), -std::numeric_limits<double>::infinity());
   out.bottom = out.top;
+  out.cavity.assign(static_cast<size_t>(n), 0.0);
   const double* s = states.data_ptr<double>();
   const double* x = vertices.data_ptr<double>();
   Points3 pts(2 * v, 3);
@@ -56,6 +60,7 @@ FrameDepths frame_depths(const ObjectDistance& distance, const at::Tensor& state
     check_frame_points(pts, v, t);
     out.top[static_cast<size_t>(t)] = distance.max_signed_distance(state, pts, ObjectPart::Top);
     out.bottom[static_cast<size_t>(t)] = distance.max_signed_distance(state, pts, ObjectPart::Bottom);
+    out.cavity[static_cast<size_t>(t)] = distance.max_cavity_depth(state, pts, kCavityFloor);
   }
   return out;
 }

@@ -13,6 +13,9 @@ namespace bimart {
 struct FrameDepths {
   // max over both hands' vertices of the signed distance (m, > 0 inside) to each part.
   std::vector<double> top, bottom;
+  // The deepest hand vertex in a cavity: outside the object, inside a part's convex hull
+  // (ObjectDistance::max_cavity_depth; m, 0 when none or up to 5 mm).
+  std::vector<double> cavity;
   // The whole object (union of the parts).
   double whole(size_t t) const { return top[t] > bottom[t] ? top[t] : bottom[t]; }
   size_t size() const { return top.size(); }

@@ -32,7 +32,7 @@ nlohmann::json metrics_json(const MetricsSet& s) {
                                  {"accel_cm", number(100 * m.accel)}, {"pen_1cm", count(m.pen_1cm)},
                                  {"pen_5mm", count(m.pen_5mm)}, {"con", count(m.contact)},
                                  {"art", count(m.articulation)}, {"cm_cm", number(100 * m.contact_map)},
-                                 {"pen_3mm", count(m.pen_3mm)}, {"implausible", count(m.implausible)},
+                                 {"pen_3mm", count(m.pen_3mm)}, {"implausible", count(m.implausible)}, {"cavity", count(m.cavity)},
                                  {"implausible_first", m.implausible_first}});
   }
   return j;

@@ -11,4 +11,11 @@ FrameCount penetration_frames(const FrameDepths& depths, double threshold) {
   return c;
 }
 
+FrameCount cavity_frames(const FrameDepths& depths) {
+  FrameCount c;
+  c.frames = static_cast<std::int64_t>(depths.cavity.size());
+  for (double d : depths.cavity) c.hits += d > kCavityDepth;
+  return c;
+}
+
 }  // namespace bimart

@@ -15,4 +15,11 @@ constexpr double kPenetration3mm = 0.003;  // m
 // hits = frames with whole-object depth > threshold; frames = all frames.
 FrameCount penetration_frames(const FrameDepths& depths, double threshold);
 
+// Cavity (ours, issue 38): frames with a hand vertex more than kCavityDepth inside a part's
+// convex hull while outside the object — a hand inside a hollow part, which Pen cannot see.
+// On solid, nearly convex parts it is 0; concave ones (handles, the gap of a drip tray) can
+// hold a hand legitimately, so read it beside the ground truth's.
+constexpr double kCavityDepth = 0.01;  // m
+FrameCount cavity_frames(const FrameDepths& depths);
+
 }  // namespace bimart

@@ -30,6 +30,7 @@ SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectD
   m.pen_1cm = penetration_frames(depths, kPenetration1cm);
   m.pen_5mm = penetration_frames(depths, kPenetration5mm);
   m.pen_3mm = penetration_frames(depths, kPenetration3mm);
+  m.cavity = cavity_frames(depths);
   for (size_t t = 0; t < depths.size(); ++t) {
     if (depths.whole(t) <= -kContactDistance) continue;
     m.contact_depth_sum += std::max(depths.whole(t), 0.0);
@@ -126,7 +127,8 @@ std::vector<MetricResult> aggregate_metrics(const std::vector<SequenceMetrics>& 
           frame_share_result("Con", true, s, &SequenceMetrics::contact),
           frame_share_result("Art", true, s, &SequenceMetrics::articulation),
           contact_map_result(s),
-          frame_share_result("Implaus", false, s, &SequenceMetrics::implausible)};
+          frame_share_result("Implaus", false, s, &SequenceMetrics::implausible),
+          frame_share_result("Cavity", false, s, &SequenceMetrics::cavity)};
 }
 
 }  // namespace bimart

@@ -30,6 +30,7 @@ struct SequenceMetrics {
   // Frames with a hand bent outside its joints' ranges or fingers inside each other
   // (core/metrics/hand_plausibility.h): the "Implaus" column.
   FrameCount implausible;
+  FrameCount cavity;  // frames with a hand in a part's cavity (core/metrics/penetration.h): "Cavity"
   std::string implausible_first;  // the first such frame and why ("frame 3, left hand: ...")
   double contact_map = std::numeric_limits<double>::quiet_NaN();  // m; NaN without a condition
 };
@@ -49,8 +50,9 @@ SequenceMetrics evaluate_sequence(const ArticulatedObject& object, const ObjectD
                                   const SequenceData& data);
 
 // The table's columns: the paper's Mul, Accel, Pen 1cm, Pen 5mm, then Pen 3mm and Depth (mm,
-// the mean deepest penetration over contact frames), then Con, Art, CM, and Implaus (ours:
-// % of frames with an implausible hand).
+// the mean deepest penetration over contact frames), then Con, Art, CM, Implaus (ours:
+// % of frames with an implausible hand) and Cavity (ours: % of frames with a hand inside a
+// hollow part).
 // `mul_per_trajectory` in metres (one value per trajectory with >= 2 samples). A column
 // with nothing to average has value NaN and num_sequences 0.
 std::vector<MetricResult> aggregate_metrics(const std::vector<SequenceMetrics>& sequences,

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
+#include <vector>
+
+#include "core/geometry/convex_hull.h"
 
 namespace bimart {
 namespace {
@@ -21,8 +25,56 @@ PartFrames part_frames(const ObjectState& state) {
 
 }  // namespace
 
+namespace {
+
+Eigen::Matrix<double, Eigen::Dynamic, 4> hull_planes(const TriangleMesh& part) {
+  const TriangleMesh hull = convex_hull(part.vertices);
+  std::vector<std::pair<double, Eigen::Vector4d>> faces;  // area, plane
+  for (Eigen::Index f = 0; f < hull.num_faces(); ++f) {
+    const Eigen::Vector3d a = hull.vertices.row(hull.faces(f, 0)), b = hull.vertices.row(hull.faces(f, 1)),
+                          c = hull.vertices.row(hull.faces(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const Eigen::Vector3d u = n.normalized();
+    faces.push_back({n.norm(), Eigen::Vector4d(u.x(), u.y(), u.z(), u.dot(a))});
+  }
+  // Largest faces first: a point outside is usually rejected by one of the first planes.
+  std::sort(faces.begin(), faces.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+  Eigen::Matrix<double, Eigen::Dynamic, 4> planes(static_cast<Eigen::Index>(faces.size()), 4);
+  for (size_t f = 0; f < faces.size(); ++f) planes.row(static_cast<Eigen::Index>(f)) = faces[f].second.transpose();
+  return planes;
+}
+
+// How far p lies inside the convex polytope (m), or any value ≤ `stop` once it is known to
+// be no more than `stop` (≤ 0: outside).
+double depth_inside(const Eigen::Matrix<double, Eigen::Dynamic, 4>& planes, const Eigen::Vector3d& p, double stop) {
+  double depth = std::numeric_limits<double>::infinity();
+  for (Eigen::Index f = 0; f < planes.rows(); ++f) {
+    depth = std::min(depth, planes(f, 3) - planes(f, 0) * p.x() - planes(f, 1) * p.y() - planes(f, 2) * p.z());
+    if (depth <= stop) break;
+  }
+  return depth;
+}
+
+}  // namespace
+
 ObjectDistance::ObjectDistance(const ArticulatedObject& object)
-    : top_(object.top), bottom_(object.bottom) {}
+    : top_(object.top), bottom_(object.bottom), top_hull_(hull_planes(object.top)),
+      bottom_hull_(hull_planes(object.bottom)) {}
+
+double ObjectDistance::max_cavity_depth(const ObjectState& state, const Points3& points_world, double floor) const {
+  const PartFrames f = part_frames(state);
+  double best = std::max(floor, 0.0);
+  for (Eigen::Index i = 0; i < points_world.rows(); ++i) {
+    const Eigen::Vector3d p = points_world.row(i).transpose();
+    const Eigen::Vector3d p_top = f.world_to_top * p, p_bottom = f.world_to_bottom * p;
+    const double inside_hull = std::max(depth_inside(top_hull_, p_top, best), depth_inside(bottom_hull_, p_bottom, best));
+    if (inside_hull <= best) continue;
+    const double sd = std::max(top_.signed_distance(p_top), bottom_.signed_distance(p_bottom));
+    if (sd >= 0) continue;  // inside the object: penetration, not a cavity
+    best = std::max(best, std::min(inside_hull, -sd));
+  }
+  return best > floor ? best : 0.0;
+}
 
 ObjectSurfaceQuery ObjectDistance::query(const ObjectState& state, const Eigen::Vector3d& p_world,
                                          ObjectPart part) const {

@@ -47,12 +47,24 @@ class ObjectDistance {
                                                                const Points3& points_world,
                                                                double margin) const;
 
+  // How deep the deepest of the points lies in a cavity (m; 0 when none does): outside the
+  // object, inside a part's convex hull, by the smaller of the two distances. A hand inside
+  // a hollow part (a box's inside, the space between scissor blades) is outside the object,
+  // so the signed distance calls it free; its hull does not (issue 38, "hollow parts").
+  // Depths up to `floor` read 0: points less deep than it inside a hull are not queried
+  // against the object (most of a hand touching a rounded part is just inside its hull).
+  double max_cavity_depth(const ObjectState& state, const Points3& points_world, double floor = 0) const;
+
   const MeshDistance& top() const { return top_; }
   const MeshDistance& bottom() const { return bottom_; }
 
  private:
   MeshDistance top_;
   MeshDistance bottom_;
+  // Each part's convex hull (core/geometry/convex_hull.h) as its face planes [F, 4]: outward
+  // unit normal n and offset c, n·p ≤ c inside. Inside a convex polytope the distance to its
+  // surface is the smallest c − n·p, so no tree is needed.
+  Eigen::Matrix<double, Eigen::Dynamic, 4> top_hull_, bottom_hull_;
 };
 
 }  // namespace bimart

@@ -75,6 +75,8 @@ struct HandData {
   double s_pin = 0;
   std::optional<JointLimits> limits;  // the model's; residual scale √(2 w_limits / N) · ℓ_f
   double s_limits = 0;
+  std::vector<double> p_start;  // [N × 51] the start's parameters (w_pose), s_pose √(2 w_pose / N) · ℓ_f
+  double s_pose = 0;
   // What Ceres optimises, [N × 51]: x itself, or with RefineOptions::joint_angles x with
   // each finger joint's axis-angle as its three bounded angles (JointLimits::rotation).
   bool angles = false;
@@ -551,6 +553,15 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   e.terms.hold = o.w_hold * hold / static_cast<double>(N);
   e.terms.pin = pin_cost(*d, w_pin);
   e.terms.limits = o.w_limits * kLeverFinger * kLeverFinger * limit_excess_sum(*d) / static_cast<double>(N);
+  if (o.w_pose > 0) {
+    double sq = 0;
+    std::vector<double> q(kX);
+    for (int64_t t = 0; t < N; ++t) {
+      params_of(*d, d->x.data() + t * kX, q.data());
+      for (int i = 3; i < 48; ++i) sq += std::pow(q[static_cast<size_t>(i)] - d->p_start[static_cast<size_t>(t * kX + i)], 2);
+    }
+    e.terms.pose = o.w_pose * kLeverFinger * kLeverFinger * sq / static_cast<double>(N);
+  }
   e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
   e.keypoint_error = kerr / nk;
   return e;
@@ -680,6 +691,9 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   d->s_hold = std::sqrt(2 * o.w_hold / static_cast<double>(d->N));
   d->s_pin = std::sqrt(2 * w_pin);
   d->s_limits = std::sqrt(2 * o.w_limits / static_cast<double>(d->N)) * kLeverFinger;
+  d->s_pose = std::sqrt(2 * o.w_pose / static_cast<double>(d->N)) * kLeverFinger;
+  d->p_start.resize(d->x.size());
+  for (int64_t t = 0; t < d->N; ++t) params_of(*d, d->x.data() + t * kX, d->p_start.data() + t * kX);
   for (int p : d->hold_part) rep->held_frames += p >= 0;
   d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
@@ -720,6 +734,10 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
           problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FingerLimitCost, 9, 9>(
                                        new FingerLimitCost{&*d->limits, g, d->s_limits, d->angles}),
                                    nullptr, x + 3 + 9 * g);
+      if (o.w_pose > 0 && !d->is_kept(t))
+        for (int g = 0; g < 5; ++g)
+          problem.AddResidualBlock(new ValuePinCost<9>(d->p_start.data() + t * kX + 3 + 9 * g, d->s_pose), nullptr,
+                                   x + 3 + 9 * g);
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {
         const std::vector<Block> blocks = blocks_of(mask);
@@ -901,6 +919,7 @@ void RefineOptions::validate() const {
   nonneg(w_fit, "w_fit");
   nonneg(w_hold, "w_hold");
   nonneg(w_limits, "w_limits");
+  nonneg(w_pose, "w_pose");
   nonneg(pen_margin, "pen_margin");
   if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
@@ -963,10 +982,10 @@ std::string format_refine_report(const RefineReport& r) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
         "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}, "
-        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped); {} steps cut back; "
+        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped), pose {:.3g}; {} steps cut back; "
         "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
-        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.after.pose, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
         x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;

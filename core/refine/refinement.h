@@ -10,6 +10,7 @@
 //   w_hold · Σ_{t held} max(0, −sd(K_t*))² / N           a hand on the object where it must be (ours)
 //   w_limits · Σ_{t,j} ||0.03 m · excess_tj||² / N       anatomical joint limits (ours; core/hand/joint_limits.h),
 //                                                         with every joint clamped into its range after each round
+//   w_pose · Σ_t ||0.03 m · (θ_t − θ_fit,t)||² / N       finger pose near the fit's (ours)
 // The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
 // converges, so it squares them and adds the fit term to hold what the other terms leave
 // free (a contact constrains a keypoint along the surface normal only). Its weights
@@ -81,6 +82,13 @@ struct RefineOptions {
   // of the object less well — Levenberg–Marquardt stalls on the penalty's edge — so the
   // default waits for joint angles as bounded parameters.
   double w_limits = 0;
+  // Finger pose held near the start's (ours; 0 = the paper's, the library default):
+  // w_pose · Σ_t ||0.03 m · (θ_t − θ_start,t)||² / N over the finger parameters, so
+  // penetration is resolved by moving the hand rather than by curling its fingers (the
+  // start, the MANO fit, has anatomical fingers). Measured (docs/refinement.md): free, the
+  // refinement curled fingers into fists (Implaus 98 %); with 1e4, 10 %, and Pen 5mm
+  // 38 → 31 %. pipelines/bimart.yaml sets 1e4.
+  double w_pose = 0;
   // Finger joints as bounded angles (ours, off by default): each joint's flexion, abduction
   // and twist (JointLimits::rotation) are the solver's parameters, bounded by their
   // anatomical ranges, so every step stays inside them (the thumb's box corners, outside its
@@ -131,8 +139,8 @@ struct RefineDirections {
 
 // The terms of the cost as defined above, weighted, with exact surface distances.
 struct RefineTerms {
-  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0, limits = 0;
-  double total() const { return proj + pen + acc + fit + hold + pin + limits; }
+  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0, limits = 0, pose = 0;
+  double total() const { return proj + pen + acc + fit + hold + pin + limits + pose; }
 };
 struct RefineHandReport {
   RefineTerms before, after;

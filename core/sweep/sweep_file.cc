@@ -74,7 +74,7 @@ ModelSpec read_model(const Reader& r, const YAML::Node& n, const std::string& na
 }  // namespace
 
 const std::vector<std::string>& metric_columns() {
-  static const std::vector<std::string> c{"Mul", "Accel", "Pen 1cm", "Pen 5mm", "Pen 3mm", "Depth", "Con", "Art", "CM", "Implaus"};
+  static const std::vector<std::string> c{"Mul", "Accel", "Pen 1cm", "Pen 5mm", "Pen 3mm", "Depth", "Con", "Art", "CM", "Implaus", "Cavity"};
   return c;
 }
 

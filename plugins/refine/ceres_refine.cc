@@ -48,6 +48,9 @@ class CeresRefineStage : public Refiner {
                    "is pulled onto it (ours; 0 = off, the paper's)")
             .param("w_limits", d.w_limits,
                    "anatomical finger-joint limits (ours; 0 = off, the paper's): core/hand/joint_limits.h")
+            .param("w_pose", d.w_pose,
+                   "finger pose held near the fit's: penetration resolved by moving the hand, not curling fingers "
+                   "(ours; 0 = off, the paper's)")
             .param("joint_angles", d.joint_angles,
                    "finger joints as angles bounded by their anatomical ranges (ours; false: axis-angles, the paper's)")
             .param("backtrack", d.backtrack,
@@ -77,6 +80,7 @@ class CeresRefineStage : public Refiner {
     o_.threads = static_cast<int>(p.integer("threads"));
     o_.w_hold = p.number("w_hold");
     o_.w_limits = p.number("w_limits");
+    o_.w_pose = p.number("w_pose");
     o_.joint_angles = p.boolean("joint_angles");
     o_.backtrack = p.boolean("backtrack");
     o_.validate();

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/object/families/families.h"
+#include "core/object/families/primitives.h"
 #include "core/object/object_state.h"
 
 namespace bimart {
@@ -102,6 +103,40 @@ TEST(ObjectDistance, BoxPartsKnownDepths) {
               0.005, 1e-9);
   EXPECT_NEAR(od.signed_distances(s, Points3(Eigen::RowVector3d(1.005, 2.1, 3)), ObjectPart::Bottom)(0),
               -std::hypot(0.005, 0.1), 1e-9);
+}
+
+// An open box (five 5 mm walls, open at +y, as a hollow part arrives from a scan) and a
+// solid lid beside it: a point in the cavity is outside the object but deep inside the box's
+// hull; the solid lid has none.
+TEST(ObjectDistance, CavityDepthOfAHollowPart) {
+  ArticulatedObject o;
+  const double a = 0.1, w = 0.005;
+  o.bottom = make_box({-a, -a, -a}, {a, -a + w, a});                 // floor
+  shapes::append(o.bottom, make_box({-a, -a, -a}, {-a + w, a, a}));           // four walls
+  shapes::append(o.bottom, make_box({a - w, -a, -a}, {a, a, a}));
+  shapes::append(o.bottom, make_box({-a, -a, -a}, {a, a, -a + w}));
+  shapes::append(o.bottom, make_box({-a, -a, a - w}, {a, a, a}));
+  o.top = make_box({0.3, -a, -a}, {0.5, a, a});  // solid, off to the side
+  const ObjectDistance od(o);
+  ObjectState s;
+  s.root_translation = Eigen::Vector3d(1, 0, 0);
+  const auto depth = [&](double x, double y, double z) {
+    return od.max_cavity_depth(s, Points3(Eigen::RowVector3d(1 + x, y, z)));
+  };
+  // The centre: 10 cm inside the hull, 9.5 cm from the nearest inner wall.
+  EXPECT_NEAR(depth(0, 0, 0), a - w, 1e-9);
+  // Near the opening: only 2 cm inside the hull.
+  EXPECT_NEAR(depth(0, a - 0.02, 0), 0.02, 1e-9);
+  EXPECT_EQ(depth(0, 2 * a, 0), 0.0);         // above the box
+  EXPECT_EQ(depth(-a + w / 2, 0, 0), 0.0);    // inside a wall: penetration, not a cavity
+  EXPECT_EQ(depth(0.4, 0, 0), 0.0);           // inside the solid part
+  EXPECT_EQ(depth(0.6, 0, 0), 0.0);           // beside it
+  // The deepest of several points.
+  Points3 many(3, 3);
+  many << 1, 2 * a, 0, 1, a - 0.03, 0, 1, a - 0.02, 0;
+  EXPECT_NEAR(od.max_cavity_depth(s, many), 0.03, 1e-9);
+  EXPECT_NEAR(od.max_cavity_depth(s, many, 0.025), 0.03, 1e-9);  // a floor below the answer changes nothing
+  EXPECT_EQ(od.max_cavity_depth(s, many, 0.04), 0.0);            // ... above it, 0
 }
 
 }  // namespace

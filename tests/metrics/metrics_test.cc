@@ -142,8 +142,11 @@ TEST(SequenceMetrics, EndToEndOnABoxWithPlacedVertices) {
   EXPECT_EQ(m.pen_3mm.hits, 2);
   EXPECT_EQ(m.contact_depth_frames, 4);
   EXPECT_NEAR(m.contact_depth_sum, 0.033, 1e-9);
+  // Solid boxes have no cavity: a vertex inside a part's hull is inside the part.
+  EXPECT_EQ(m.cavity.frames, 6);
+  EXPECT_EQ(m.cavity.hits, 0);
   const auto table = aggregate_metrics({m, m}, {0.01, 0.03});
-  ASSERT_EQ(table.size(), 10u);
+  ASSERT_EQ(table.size(), 11u);
   EXPECT_EQ(table[0].name, "Mul");
   EXPECT_NEAR(table[0].value, 2.0, 1e-12);
   EXPECT_EQ(table[2].name, "Pen 1cm");
@@ -156,6 +159,9 @@ TEST(SequenceMetrics, EndToEndOnABoxWithPlacedVertices) {
   EXPECT_NEAR(table[5].value, 8.25, 1e-6);
   EXPECT_NEAR(table[6].value, 80.0, 1e-12);
   EXPECT_TRUE(std::isnan(table[8].value));
+  EXPECT_EQ(table[10].name, "Cavity");
+  EXPECT_EQ(table[10].denominator, 12);
+  EXPECT_EQ(table[10].value, 0.0);
 }
 
 TEST(HandVertices, PosesWithTheShippedModelWhenVerticesAreMissing) {

@@ -102,7 +102,7 @@ TEST_F(ShippedPipeline, TwoSamplesWriteEveryOutput) {
   EXPECT_EQ(g["trajectories_with_samples"], 1);
   std::vector<std::string> names;
   for (const auto& m : g["metrics"]) names.push_back(m["name"]);
-  EXPECT_EQ(names, (std::vector<std::string>{"Mul", "Accel", "Pen 1cm", "Pen 5mm", "Pen 3mm", "Depth", "Con", "Art", "CM", "Implaus"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"Mul", "Accel", "Pen 1cm", "Pen 5mm", "Pen 3mm", "Depth", "Con", "Art", "CM", "Implaus", "Cavity"}));
   for (const auto& m : g["metrics"])
     if (m["name"] == "Mul" || m["name"] == "Accel" || m["name"] == "Pen 1cm" || m["name"] == "CM")
       EXPECT_TRUE(m["value"].is_number()) << m.dump();  // defined for any trajectory

@@ -138,6 +138,34 @@ TEST(Refinement, PenetrationAlonePushesAHandOut) {
   }
 }
 
+// Finger pose held (w_pose): the hands pushed out of the slab by the penetration term alone
+// keep their fingers nearer the fit's pose than without it — the hand moves instead — and
+// still come out.
+TEST(Refinement, HeldFingerPoseMovesTheHandInsteadOfTheFingers) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const PushedHands c = pushed_into_the_slab(object, 4, 0.008f);
+  const auto finger_change = [&](const HandMotion& m) {  // largest |θ − θ_fit| over finger parameters (rad)
+    double worst = 0;
+    for (int h = 0; h < 2; ++h)
+      worst = std::max(worst, (m.hands[h].pose - c.fit.hands[h].pose).abs().max().item<double>());
+    return worst;
+  };
+  RefineOptions o;
+  o.w_proj = 0;
+  RefineReport free_report, held_report;
+  const double free_change = finger_change(refine_hands(models, distance, c.states, c.pushed, c.fit, o, &free_report));
+  o.w_pose = 1e4;
+  const double held_change = finger_change(refine_hands(models, distance, c.states, c.pushed, c.fit, o, &held_report));
+  std::printf("largest finger change: free %.4f rad, held %.4f rad\n", free_change, held_change);
+  EXPECT_LT(held_change, 0.5 * free_change);
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_LE(held_report.hands[h].max_depth_after, o.pen_tolerance);
+    EXPECT_GT(held_report.hands[h].after.pose, 0.0);  // the term is evaluated and reported
+  }
+}
+
 // A part thinner than twice the depth: hands predicted 1.5 cm into a 2 cm slab have their
 // deepest vertices nearer its underside. Pushed each to its nearest surface they split and
 // stay stuck; pushed towards the rest of the hand (pen_exit_depth) they all leave on top.
