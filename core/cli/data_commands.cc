@@ -1,6 +1,7 @@
 // bimart data synth | check | stats | turn: make a synthetic data set, check it, normalisation statistics,
 // a copy with its objects turned about their hinges.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <iostream>
 
@@ -77,20 +78,24 @@ void add_data_commands(CLI::App& app, Commands& out) {
                  },
                  false});
   static std::string turn_folder, turn_split = "test", turn_out;
-  static double turn_degrees = 90;
+  static std::vector<double> turn_degrees{90};
   static bool turn_force = false;
   CLI::App* turn = data->add_subcommand(
       "turn", "a copy of a split with every object turned about its hinge axis, the world motion unchanged (docs/objects.md)");
   turn->add_option("folder", turn_folder, "data set folder (with manifest.json)")->required();
   turn->add_option("--split", turn_split, "train or test")->capture_default_str();
-  turn->add_option("--degrees", turn_degrees, "the turn about the hinge axis (degrees)")->capture_default_str();
+  turn->add_option("--degrees", turn_degrees,
+                   "the turn about the hinge axis (degrees); several (0,90,180,270) write a copy per turn, names "
+                   "ending _t<degrees>")
+      ->delimiter(',')
+      ->capture_default_str();
   turn->add_option("--out", turn_out, "the new data set's folder")->required();
   turn->add_flag("--force", turn_force, "replace the data set already in --out");
   out.push_back({turn,
                  [] {
                    const TurnedDatasetSummary s = write_turned_dataset(turn_folder, turn_split, turn_degrees, turn_out, turn_force);
                    std::cout << fmt::format("wrote {}: {} objects, {} {} sequences turned by {} deg about the hinge axis\n",
-                                            turn_out, s.objects, s.sequences, turn_split, turn_degrees);
+                                            turn_out, s.objects, s.sequences, turn_split, fmt::join(turn_degrees, ", "));
                    return 0;
                  },
                  false});

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "core/object/articulated_object.h"
 #include "core/object/object_state.h"
@@ -23,10 +24,14 @@ struct TurnedDatasetSummary {
 };
 
 // Writes `out` (a data set folder: manifest.json, objects/, sequences/) with the sequences of
-// `split` of the data set `folder` and their objects turned by `degrees`; the manifest
-// lists them under the same split. Throws bimart::Error when `out` holds a data set already
-// (unless `force`) or a sequence cannot be read.
-TurnedDatasetSummary write_turned_dataset(const std::string& folder, const std::string& split, double degrees,
-                                          const std::string& out, bool force = false);
+// `split` of the data set `folder` and their objects turned by each of `degrees`; the
+// manifest lists them under the same split. One angle keeps every name (an evaluation set
+// turned); several write one copy per angle, named with "_t<degrees>" (box_05_t90; 0 = the
+// original), e.g. training data in several turns. Throws bimart::Error when `out` holds a
+// data set already (unless `force`), for no or a non-finite angle, or when a sequence
+// cannot be read.
+TurnedDatasetSummary write_turned_dataset(const std::string& folder, const std::string& split,
+                                          const std::vector<double>& degrees, const std::string& out,
+                                          bool force = false);
 
 }  // namespace bimart

@@ -39,7 +39,7 @@ TEST(TurnedDataset, WritesTheSplitWithTurnedObjectsAndCompensatedStates) {
   const auto& tiny = testing_data::tiny_dataset();
   const auto out = tiny.dir.parent_path() / (tiny.dir.filename().string() + "_turned");
   std::filesystem::remove_all(out);
-  const TurnedDatasetSummary s = write_turned_dataset(tiny.dir.string(), "train", 180, out.string());
+  const TurnedDatasetSummary s = write_turned_dataset(tiny.dir.string(), "train", {180}, out.string());
   EXPECT_EQ(s.objects, 1);
   EXPECT_EQ(s.sequences, 3);
   const DatasetManifest m = read_manifest(out.string());
@@ -56,7 +56,20 @@ TEST(TurnedDataset, WritesTheSplitWithTurnedObjectsAndCompensatedStates) {
     EXPECT_LT((pa.bottom - pb.bottom).cwiseAbs().maxCoeff(), 1e-5) << t;
   }
   EXPECT_TRUE(a.hands.hands[0].trans.equal(b.hands.hands[0].trans));  // hands are in the world frame
-  EXPECT_THROW(write_turned_dataset(tiny.dir.string(), "train", 90, out.string()), Error);  // no silent overwrite
+  EXPECT_THROW(write_turned_dataset(tiny.dir.string(), "train", {90}, out.string()), Error);  // no silent overwrite
+  // Several turns: a copy each, named apart; the 0° copy is the original.
+  const TurnedDatasetSummary several = write_turned_dataset(tiny.dir.string(), "test", {0, 90}, out.string(), true);
+  EXPECT_EQ(several.objects, 2);
+  EXPECT_EQ(several.sequences, 2);
+  const DatasetManifest m2 = read_manifest(out.string());
+  EXPECT_EQ(m2.test, (std::vector<std::string>{"sequences/test_d_t0.npz", "sequences/test_d_t90.npz"}));
+  EXPECT_TRUE(m2.train.empty());
+  const Sequence d0 = read_sequence((out / "sequences" / "test_d_t0.npz").string());
+  const Sequence d = read_sequence((tiny.dir / "sequences" / "test_d.npz").string());
+  EXPECT_EQ(d0.name, d.name + "_t0");
+  EXPECT_TRUE(d0.object_states.allclose(d.object_states, 1e-6, 1e-6));
+  EXPECT_FALSE(read_sequence((out / "sequences" / "test_d_t90.npz").string()).object_states.allclose(d.object_states, 1e-3, 1e-3));
+  EXPECT_THROW(write_turned_dataset(tiny.dir.string(), "test", {}, out.string(), true), Error);
   std::filesystem::remove_all(out);
 }
 
