@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/geometry/rotation.h"
+#include "core/object/canonical_frame.h"
 #include "core/object/families/families.h"
 #include "core/object/object_io.h"
 #include "core/object/part_checks.h"
@@ -23,20 +24,6 @@ namespace bimart {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Area-weighted centroid of the surface (independent of how finely it is meshed).
-Eigen::Vector3d surface_centroid(const TriangleMesh& m) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double area = 0;
-  for (Eigen::Index f = 0; f < m.num_faces(); ++f) {
-    const Eigen::Vector3d a = m.vertices.row(m.faces(f, 0)), b = m.vertices.row(m.faces(f, 1)),
-                          c = m.vertices.row(m.faces(f, 2));
-    const double w = 0.5 * (b - a).cross(c - a).norm();
-    sum += w * (a + b + c) / 3;
-    area += w;
-  }
-  return area > 0 ? Eigen::Vector3d(sum / area) : Eigen::Vector3d(m.vertices.colwise().mean());
-}
 
 void transform(TriangleMesh& m, const Eigen::Isometry3d& t) {
   for (Eigen::Index i = 0; i < m.num_vertices(); ++i)
@@ -184,27 +171,12 @@ ArticulatedObject import_object(const ImportOptions& opt, ImportReport* out) {
   rep.top.repair = close_and_orient(top, top_name);
   rep.bottom.repair = close_and_orient(bottom, bottom_name);
 
-  // 2. About the axis: the top part above the bottom part (+y), as in every family.
-  const Eigen::Vector3d ct = surface_centroid(top), cb = surface_centroid(bottom);
-  const Eigen::Vector2d up = (ct - cb).head<2>();
-  Eigen::Isometry3d roll = Eigen::Isometry3d::Identity();
-  if (up.norm() > 1e-3 * extent) {
-    roll.linear() = rotation_about(Eigen::Vector3d::UnitZ(), M_PI / 2 - std::atan2(up.y(), up.x()));
-  } else {
-    // Top and bottom side by side along the axis: put the whole object towards -x instead.
-    const Eigen::Vector2d c = (0.5 * (ct + cb)).head<2>();
-    if (c.norm() > 1e-3 * extent) roll.linear() = rotation_about(Eigen::Vector3d::UnitZ(), M_PI - std::atan2(c.y(), c.x()));
-  }
-  // 3. Along the axis: the extent along z centred on the origin.
-  transform(top, roll);
-  transform(bottom, roll);
-  const double zlo = std::min(top.vertices.col(2).minCoeff(), bottom.vertices.col(2).minCoeff());
-  const double zhi = std::max(top.vertices.col(2).maxCoeff(), bottom.vertices.col(2).maxCoeff());
-  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
-  shift.translation() = Eigen::Vector3d(0, 0, -0.5 * (zlo + zhi));
-  transform(top, shift);
-  transform(bottom, shift);
-  rep.to_canonical = shift * roll * t;
+  // 2. About the axis: the top part above the bottom part (+y), as in every family; 3. along
+  // it, the extent centred on the origin (core/object/canonical_frame.h).
+  const Eigen::Isometry3d about = canonical_pose_about_hinge(top, bottom, extent);
+  transform(top, about);
+  transform(bottom, about);
+  rep.to_canonical = about * t;
 
   for (const auto& [mesh, file] : {std::pair{&top, &top_name}, {&bottom, &bottom_name}}) {
     try {
@@ -250,6 +222,7 @@ ArticulatedObject import_object(const ImportOptions& opt, ImportReport* out) {
         "check --units; generated hands may not fit it",
         rep.size, kTrainingSizeMin, kTrainingSizeMax));
   const double cx = 0.5 * (surface_centroid(o.top).x() + surface_centroid(o.bottom).x());
+  const Eigen::Vector2d up = (surface_centroid(o.top) - surface_centroid(o.bottom)).head<2>();
   if (up.norm() > 1e-3 * extent && cx > 0)
     rep.warnings.push_back(
         "with this hinge direction a positive angle turns the top part into the bottom part (the object lies on "

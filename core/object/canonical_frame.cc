@@ -1,0 +1,43 @@
+#include "core/object/canonical_frame.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/geometry/rotation.h"
+
+namespace bimart {
+
+Eigen::Vector3d surface_centroid(const TriangleMesh& m) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double area = 0;
+  for (Eigen::Index f = 0; f < m.num_faces(); ++f) {
+    const Eigen::Vector3d a = m.vertices.row(m.faces(f, 0)), b = m.vertices.row(m.faces(f, 1)),
+                          c = m.vertices.row(m.faces(f, 2));
+    const double w = 0.5 * (b - a).cross(c - a).norm();
+    sum += w * (a + b + c) / 3;
+    area += w;
+  }
+  return area > 0 ? Eigen::Vector3d(sum / area) : Eigen::Vector3d(m.vertices.colwise().mean());
+}
+
+Eigen::Isometry3d canonical_pose_about_hinge(const TriangleMesh& top, const TriangleMesh& bottom, double extent) {
+  // About the axis: the top part above the bottom part (+y).
+  const Eigen::Vector3d ct = surface_centroid(top), cb = surface_centroid(bottom);
+  const Eigen::Vector2d up = (ct - cb).head<2>();
+  Eigen::Isometry3d roll = Eigen::Isometry3d::Identity();
+  if (up.norm() > 1e-3 * extent) {
+    roll.linear() = rotation_about(Eigen::Vector3d::UnitZ(), M_PI / 2 - std::atan2(up.y(), up.x()));
+  } else {
+    // Top and bottom side by side along the axis: put the whole object towards -x instead.
+    const Eigen::Vector2d c = (0.5 * (ct + cb)).head<2>();
+    if (c.norm() > 1e-3 * extent) roll.linear() = rotation_about(Eigen::Vector3d::UnitZ(), M_PI - std::atan2(c.y(), c.x()));
+  }
+  // Along the axis: the extent along z centred on the origin (a turn about z keeps z).
+  const double zlo = std::min(top.vertices.col(2).minCoeff(), bottom.vertices.col(2).minCoeff());
+  const double zhi = std::max(top.vertices.col(2).maxCoeff(), bottom.vertices.col(2).maxCoeff());
+  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+  shift.translation() = Eigen::Vector3d(0, 0, -0.5 * (zlo + zhi));
+  return shift * roll;
+}
+
+}  // namespace bimart
