@@ -23,10 +23,6 @@ PartFrames part_frames(const ObjectState& state) {
   return f;
 }
 
-}  // namespace
-
-namespace {
-
 Eigen::Matrix<double, Eigen::Dynamic, 4> hull_planes(const TriangleMesh& part) {
   const TriangleMesh hull = convex_hull(part.vertices);
   std::vector<std::pair<double, Eigen::Vector4d>> faces;  // area, plane
