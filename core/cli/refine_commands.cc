@@ -277,6 +277,8 @@ void add_refine_commands(CLI::App& app, Commands& out) {
       ->capture_default_str();
   cmd->add_option("--fit-w-limits", o.fit.w_limits, "MANO fit: anatomical joint-limit weight (0 = off)")
       ->capture_default_str();
+  cmd->add_option("--fit-w-fingers", o.fit.w_fingers, "MANO fit: fingers side by side across the hand (0 = off)")
+      ->capture_default_str();
   cmd->add_option("--pen-exit-depth", o.refine.pen_exit_depth,
                   "refinement: frames deeper than this (m) push inside vertices out towards the rest of the hand (1e9 = off)")
       ->capture_default_str();

@@ -29,6 +29,7 @@
 #include "core/hand/keypoints.h"
 #include "core/io/sequence.h"
 #include "core/metrics/hand_vertices.h"
+#include "core/object/canonical_frame.h"
 #include "core/object/object_io.h"
 #include "core/util/atomic_file.h"
 #include "core/util/data_path.h"
@@ -46,7 +47,7 @@ using json = nlohmann::json;
 constexpr int kObjectRow = kBasisRows * 3;         // O numbers per frame
 constexpr int kContactRow = 2 * kBasisRows;        // C numbers per frame
 constexpr const char kCacheMagic[9] = "BMFEAT01";  // 8 bytes, then the header length
-constexpr int kCacheVersion = 1;
+constexpr int kCacheVersion = 2;  // 2: objects in their canonical pose about the hinge
 
 std::int64_t mtime_of(const fs::path& p) {
   std::error_code ec;
@@ -119,10 +120,12 @@ std::string basis_fingerprint(const BpsBasis& b) {
   return f.hex();
 }
 
-// Objects by resolved path, each loaded once and shared by the worker threads.
+// Objects by resolved path, each loaded once, moved to its canonical pose about the hinge
+// (core/object/canonical_frame.h: what the models see, however the object is turned in its
+// files) and shared by the worker threads.
 class ObjectStore {
  public:
-  std::shared_ptr<const ArticulatedObject> get(const std::string& path) {
+  std::shared_ptr<const CanonicalObject> get(const std::string& path) {
     std::shared_ptr<Slot> slot;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -130,14 +133,14 @@ class ObjectStore {
       if (!s) s = std::make_shared<Slot>();
       slot = s;
     }
-    std::call_once(slot->once, [&] { slot->object = std::make_shared<ArticulatedObject>(load_object(path)); });
+    std::call_once(slot->once, [&] { slot->object = std::make_shared<CanonicalObject>(to_canonical(load_object(path))); });
     return slot->object;
   }
 
  private:
   struct Slot {
     std::once_flag once;
-    std::shared_ptr<const ArticulatedObject> object;
+    std::shared_ptr<const CanonicalObject> object;
   };
   std::mutex mutex_;
   std::map<std::string, std::shared_ptr<Slot>> slots_;
@@ -163,8 +166,12 @@ DatasetSequence compute_sequence(const std::string& path, ObjectStore& objects, 
   d.fps = seq.fps;
   d.object_path = resolve_object_path(seq, path);
   d.frames = seq.num_frames();
-  const std::shared_ptr<const ArticulatedObject> object = objects.get(d.object_path);
-  const at::Tensor states = seq.object_states.to(at::kCPU, at::kFloat).contiguous();
+  const std::shared_ptr<const CanonicalObject> canonical = objects.get(d.object_path);
+  const ArticulatedObject* object = &canonical->object;
+  const at::Tensor states =
+      (canonical->moved ? canonical_states(seq.object_states, canonical->from_source) : seq.object_states)
+          .to(at::kCPU, at::kFloat)
+          .contiguous();
   const int64_t n = d.frames;
 
   const ObjectEncoding enc = encode_object(*object, states, *in.basis, in.variant);

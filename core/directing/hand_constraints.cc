@@ -10,8 +10,11 @@
 #include <sstream>
 
 #include "core/io/sequence.h"
+#include "core/object/canonical_frame.h"
+#include "core/object/object_io.h"
 #include "core/object/object_state.h"
 #include "core/trajectory/yaml_reader.h"
+#include "core/util/log.h"
 #include "core/util/yaml_keys.h"
 
 namespace bimart {
@@ -320,8 +323,18 @@ PinnedPose read_pinned_pose(const HandPin& pin) {
     const at::Tensor d = t.to(at::kDouble).contiguous();
     return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel()));
   };
+  // The source's object pose for the object in its canonical pose, as the pipeline poses it
+  // (core/object/canonical_frame.h). A sample the pipeline wrote names its canonical copy
+  // already; when the object cannot be read, its pose is taken as it is.
+  Eigen::Isometry3d from_source = Eigen::Isometry3d::Identity();
+  try {
+    from_source = to_canonical(load_object(resolve_object_path(seq, pin.source))).from_source;
+  } catch (const Error& e) {
+    log::warn("pose pin: {}: the object's canonical pose is unknown ({}); its pose is taken as stored", pin.source,
+              e.what());
+  }
   return {Eigen::Vector3d(vec(p.rot[f])), Eigen::Vector3d(vec(p.trans[f])), vec(p.pose[f]), vec(p.shape),
-          object_pose_at(seq.object_states, f)};
+          object_pose_at(seq.object_states, f) * from_source.inverse()};
 }
 
 void merge_hand_constraints(HandConstraints& base, const HandConstraints& extra) {

@@ -1,9 +1,12 @@
 #include "core/object/canonical_frame.h"
 
+#include <ATen/ATen.h>
+
 #include <algorithm>
 #include <cmath>
 
 #include "core/geometry/rotation.h"
+#include "core/object/mesh_repair.h"
 
 namespace bimart {
 
@@ -38,6 +41,44 @@ Eigen::Isometry3d canonical_pose_about_hinge(const TriangleMesh& top, const Tria
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
   shift.translation() = Eigen::Vector3d(0, 0, -0.5 * (zlo + zhi));
   return shift * roll;
+}
+
+CanonicalObject to_canonical(const ArticulatedObject& object) {
+  CanonicalObject c;
+  c.object = object;
+  const double extent = std::max({bounding_radius(object.top), bounding_radius(object.bottom), 1e-12});
+  const Eigen::Isometry3d pose = canonical_pose_about_hinge(object.top, object.bottom, extent);
+  const double angle = Eigen::AngleAxisd(pose.linear()).angle();
+  if (angle < 1e-9 && pose.translation().norm() < 1e-9 * extent) return c;
+  c.from_source = pose;
+  c.moved = true;
+  for (TriangleMesh* m : {&c.object.top, &c.object.bottom}) {
+    const Eigen::Matrix3d R = pose.linear();
+    m->vertices = (m->vertices * R.transpose()).rowwise() + pose.translation().transpose();
+  }
+  return c;
+}
+
+at::Tensor canonical_states(const at::Tensor& states, const Eigen::Isometry3d& from_source) {
+  const at::Tensor s = states.to(at::kCPU, at::kDouble).contiguous();
+  const std::int64_t n = s.size(0);
+  at::Tensor out = s.clone();
+  const double* in = s.data_ptr<double>();
+  double* o = out.data_ptr<double>();
+  const Eigen::Isometry3d back = from_source.inverse();
+  for (std::int64_t t = 0; t < n; ++t) {
+    const double* r = in + 7 * t;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = axis_angle_to_matrix(Eigen::Vector3d(r[1], r[2], r[3]));
+    T.translation() = Eigen::Vector3d(r[4], r[5], r[6]);
+    const Eigen::Isometry3d U = T * back;
+    const Eigen::Vector3d aa = matrix_to_axis_angle(U.linear());
+    for (int k = 0; k < 3; ++k) {
+      o[7 * t + 1 + k] = aa[k];
+      o[7 * t + 4 + k] = U.translation()[k];
+    }
+  }
+  return out.to(states.scalar_type());
 }
 
 }  // namespace bimart

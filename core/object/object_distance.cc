@@ -30,7 +30,12 @@ Eigen::Matrix<double, Eigen::Dynamic, 4> hull_planes(const TriangleMesh& part) {
     const Eigen::Vector3d a = hull.vertices.row(hull.faces(f, 0)), b = hull.vertices.row(hull.faces(f, 1)),
                           c = hull.vertices.row(hull.faces(f, 2));
     const Eigen::Vector3d n = (b - a).cross(c - a);
+    if (!(n.norm() > 0)) continue;
     const Eigen::Vector3d u = n.normalized();
+    // A sliver of a flat facet (three nearly collinear points) gets its normal from rounding
+    // and would cut into the hull; only supporting planes are kept: no hull vertex beyond
+    // the plane by more than 0.1 µm. The facet's other triangles give its plane.
+    if ((hull.vertices * u).maxCoeff() - u.dot(a) > 1e-7) continue;
     faces.push_back({n.norm(), Eigen::Vector4d(u.x(), u.y(), u.z(), u.dot(a))});
   }
   // Largest faces first: a point outside is usually rejected by one of the first planes.

@@ -1,10 +1,10 @@
 // `bimart object import`: a user's two part meshes and hinge, in any frame and units, turned
 // into a canonical object (DESIGN §4; docs/trajectories.md, "Your own object"): a rigid
 // transform takes the hinge axis to -z through the origin, then everything is in metres.
-// The rest of the canonical pose follows the procedural families, whose frame the models
-// were trained in: turned about the hinge so that the top part lies above the bottom part
-// (+y, from the bottom's surface centroid to the top's), and moved along the hinge so the
-// object's extent along it is centred on the origin. Holes are filled as on load.
+// The rest is the canonical pose about the hinge every model sees
+// (core/object/canonical_frame.h): turned about the hinge so that the top part lies above the
+// bottom part (+y, from the bottom's surface centroid to the top's), and moved along the
+// hinge so the object's extent along it is centred on the origin. Holes are filled as on load.
 #pragma once
 
 #include <optional>

@@ -74,6 +74,25 @@ struct JointLimitCost {
   }
 };
 
+// Fingers side by side (core/hand/finger_order.h): scale · max(0, shortfall), 9 per frame.
+struct FingerOrderCost {
+  const LbsSubset* tips;  // the five fingertip vertices
+  double gap, scale;
+  template <class T>
+  bool operator()(const T* x, const T* beta, T* r) const {
+    T tip[5][3], J[HandModel::kNumJoints][3];
+    lbs_subset(*tips, x, x + 3, x + 48, beta, &tip[0][0], &J[0][0]);
+    finger_order_shortfall<T>(J, tip, gap, r);
+    for (int i = 0; i < kFingerOrderResiduals; ++i) r[i] = r[i] > T(0) ? T(scale) * r[i] : T(0);
+    return true;
+  }
+};
+
+ceres::CostFunction* finger_order_cost(const LbsSubset& tips, const ManoFitOptions& opt) {
+  return new ceres::AutoDiffCostFunction<FingerOrderCost, kFingerOrderResiduals, kX, kB>(
+      new FingerOrderCost{&tips, opt.finger_gap, std::sqrt(opt.w_fingers * kJ)});
+}
+
 ceres::CostFunction* joint_limit_cost(const JointLimits& limits, double w_limits) {
   return new ceres::AutoDiffCostFunction<JointLimitCost, HandModel::kPoseDim, kX>(
       new JointLimitCost{&limits, std::sqrt(w_limits * kJ) * kLeverFinger});
@@ -150,6 +169,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   const double* mean = model.hands_mean.data();
   const double prior_scale = std::sqrt(opt.w_pose * kJ) * kLeverFinger;
   const JointLimits limits(model);
+  const LbsSubset tips = LbsSubset::from(model, std::vector<int>(model.fingertips.begin(), model.fingertips.end()));
 
   auto palm_points = [&](const double* v300) {
     Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(palm.size()));
@@ -177,6 +197,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                              new PosePriorCost{prior_scale, mean}),
                          nullptr, x);
       if (opt.w_limits > 0) p.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
+      if (opt.w_fingers > 0) p.AddResidualBlock(finger_order_cost(tips, opt), nullptr, x, beta->data());
       p.SetParameterBlockConstant(beta->data());
       ceres::Solver::Summary s;
       solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
@@ -192,6 +213,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                                  new PosePriorCost{prior_scale, mean}),
                              nullptr, x);
     if (opt.w_limits > 0) problem.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
+    if (opt.w_fingers > 0) problem.AddResidualBlock(finger_order_cost(tips, opt), nullptr, x, beta->data());
     if (t > 0)
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SmoothCost, kX, kX, kX>(
                                    new SmoothCost{std::sqrt(opt.w_smooth * kJ)}),
@@ -236,6 +258,8 @@ void ManoFitOptions::validate() const {
   nonneg(w_shape, "w_shape");
   nonneg(w_smooth, "w_smooth");
   nonneg(w_limits, "w_limits");
+  nonneg(w_fingers, "w_fingers");
+  nonneg(finger_gap, "finger_gap");
   if (warm_start_iterations < 0) throw Error("mano fit: warm_start_iterations must be >= 0");
   if (max_iterations < 0) throw Error("mano fit: max_iterations must be >= 0");
   if (threads < 0) throw Error("mano fit: threads must be >= 0 (0 = all cores)");

@@ -30,6 +30,7 @@
 
 #include "core/hand/hand_model.h"
 #include "core/hand/keypoints.h"  // model_keypoints
+#include "core/hand/finger_order.h"
 #include "core/hand/hand_motion.h"
 
 namespace bimart {
@@ -40,6 +41,11 @@ struct ManoFitOptions {
   double w_smooth = 1e-2;  // first differences of θ between frames
   // Joint limits: a joint 1° beyond its range costs as much as all 100 keypoints 5 mm off.
   double w_limits = 100;
+  // Fingers side by side (core/hand/finger_order.h): a PIP, DIP or tip 1 mm short of its
+  // gap to the neighbouring finger costs as much as all 100 keypoints √w_fingers mm off.
+  // 0 = off.
+  double w_fingers = 0;
+  double finger_gap = kFingerGap;  // m
   bool fit_shape = true;   // false: β stays 0
   int warm_start_iterations = 3;  // per frame, sequentially
   int max_iterations = 30;        // the joint solve

@@ -3,15 +3,19 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "core/object/canonical_frame.h"
 #include "core/object/families/families.h"
 #include "core/object/object_io.h"
+#include "core/util/fingerprint.h"
 #include "core/util/output_path.h"
 
 namespace bimart {
 
 namespace fs = std::filesystem;
 
-std::string default_object_dir(const std::string& category, std::int64_t seed) {
+namespace {
+
+fs::path cache_objects_dir() {
   fs::path base;
   if (const char* d = std::getenv("BIMART_CACHE_DIR"); d && *d) {
     base = d;
@@ -22,7 +26,40 @@ std::string default_object_dir(const std::string& category, std::int64_t seed) {
   } else {
     base = fs::temp_directory_path() / "bimart-cache";
   }
-  return (base / "objects" / (category + "_" + std::to_string(seed))).string();
+  return base / "objects";
+}
+
+}  // namespace
+
+std::string default_object_dir(const std::string& category, std::int64_t seed) {
+  return (cache_objects_dir() / (category + "_" + std::to_string(seed))).string();
+}
+
+std::string canonical_object_dir(const ArticulatedObject& canonical) {
+  Fnv f;
+  for (const TriangleMesh* m : {&canonical.top, &canonical.bottom}) {
+    const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> v = m->vertices;
+    const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> t = m->faces.cast<int>();
+    f.add(v.data(), static_cast<std::size_t>(v.size()) * sizeof(double));
+    f.add(t.data(), static_cast<std::size_t>(t.size()) * sizeof(int));
+  }
+  f.add(canonical.name);
+  std::string name = canonical.name.empty() ? std::string("object") : canonical.name;
+  for (char& c : name)
+    if (c == '/' || c == '\\' || c == ' ') c = '_';
+  return (cache_objects_dir() / "canonical" / (name + "_" + f.hex())).string();
+}
+
+void make_canonical(TrajectoryObject& object) {
+  CanonicalObject c = to_canonical(object.object);
+  if (!c.moved) return;
+  object.object = std::move(c.object);
+  object.from_source = c.from_source;
+  object.moved = true;
+  if (!object.procedural) {
+    object.path = canonical_object_dir(object.object);
+    object.canonical_copy = true;
+  }
 }
 
 TrajectoryObject resolve_trajectory_object(const ObjectReference& chosen, const ObjectReference& from_file,
@@ -57,7 +94,7 @@ TrajectoryObject resolve_trajectory_object(const ObjectReference& chosen, const 
 }
 
 void save_trajectory_object(const TrajectoryObject& object) {
-  if (object.procedural) save_object(object.object, object.path);
+  if (object.procedural || object.canonical_copy) save_object(object.object, object.path);
 }
 
 }  // namespace bimart

@@ -22,6 +22,9 @@ class ManoFitStage : public Refiner {
                       .param("w_shape", d.w_shape, "weak prior towards β = 0")
                       .param("w_smooth", d.w_smooth, "temporal smoothness: first differences of θ")
                       .param("w_limits", d.w_limits, "anatomical finger-joint limits (0: off)")
+                      .param("w_fingers", d.w_fingers,
+                             "fingers side by side: index, middle, ring, pinky in order across the hand (0: off)")
+                      .param("finger_gap", d.finger_gap, "m, the least lateral gap between neighbouring fingers")
                       .param("fit_shape", d.fit_shape, "fit β (false: β = 0)")
                       .param("warm_start_iterations", d.warm_start_iterations, "solver steps per frame, frame by frame")
                       .param("max_iterations", d.max_iterations, "solver steps of the joint solve over all frames")
@@ -35,6 +38,8 @@ class ManoFitStage : public Refiner {
     o_.w_shape = p.number("w_shape");
     o_.w_smooth = p.number("w_smooth");
     o_.w_limits = p.number("w_limits");
+    o_.w_fingers = p.number("w_fingers");
+    o_.finger_gap = p.number("finger_gap");
     o_.fit_shape = p.boolean("fit_shape");
     o_.warm_start_iterations = static_cast<int>(p.integer("warm_start_iterations"));
     o_.max_iterations = static_cast<int>(p.integer("max_iterations"));

@@ -3,8 +3,10 @@
 #include <filesystem>
 
 #include "core/io/sequence.h"
+#include "core/object/canonical_frame.h"
 #include "core/object/object_io.h"
 #include "core/pipeline/plugin.h"
+#include "core/trajectory/trajectory_object.h"
 #include "stages/trajectory_source.h"
 
 namespace bimart {
@@ -15,7 +17,7 @@ class SequenceTrajectory : public TrajectorySource {
   static StageSpec spec() {
     return StageSpec::of<TrajectorySource>("sequence", "the object and 7-DoF trajectory of a sequence file (.npz)")
         .output<HandMotion>("ground_truth", "the file's hands, world frame, ARCTIC layout")
-        .output<std::string>("object_path", "the object's folder or YAML, absolute")
+        .output<std::string>("object_path", "the object's folder or YAML, absolute (a canonical copy when the file's object is turned)")
         .param("path", "", "sequence file (docs/formats.md, \"Sequence\")");
   }
   explicit SequenceTrajectory(const Params& p) : path_(p.string("path")) {
@@ -23,12 +25,19 @@ class SequenceTrajectory : public TrajectorySource {
   }
   void run(StageIO& io) override {
     const Sequence s = read_sequence(path_);
-    const std::string object_path = std::filesystem::absolute(resolve_object_path(s, path_)).string();
-    io.out("object", load_object(object_path));
-    io.out("object_states", s.object_states.to(at::kFloat).contiguous());
+    TrajectoryObject o;
+    o.path = std::filesystem::absolute(resolve_object_path(s, path_)).string();
+    o.object = load_object(o.path);
+    // The object in its canonical pose about the hinge, the states moved with it, so that
+    // the world geometry is the file's (trajectory.file does the same).
+    make_canonical(o);
+    save_trajectory_object(o);
+    io.out("object", o.object);
+    io.out("object_states",
+           (o.moved ? canonical_states(s.object_states, o.from_source) : s.object_states).to(at::kFloat).contiguous());
     io.out("fps", s.fps);
     io.out("ground_truth", s.hands);
-    io.out("object_path", object_path);
+    io.out("object_path", o.path);
   }
 
  private:

@@ -5,11 +5,13 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "core/directing/hand_constraints.h"
 #include "core/util/log.h"
 
+#include "core/object/canonical_frame.h"
 #include "core/pipeline/plugin.h"
 #include "core/trajectory/trajectory.h"
 #include "core/trajectory/trajectory_object.h"
@@ -69,13 +71,24 @@ class FileTrajectory : public TrajectorySource {
                                                  : read_hand_constraints(more, trajectory_, true));
     }
     read_redraw(p, path);
+    // What the models see: the object in its canonical pose about the hinge, the states and
+    // the object-frame regions moved with it (the world geometry is unchanged).
+    make_canonical(object_);
+    if (object_.moved) {
+      log::info("trajectory.file: the object turned to its canonical pose about the hinge ({:.1f} deg){}",
+                Eigen::AngleAxisd(object_.from_source.linear()).angle() * 180 / M_PI,
+                object_.canonical_copy ? "; its canonical copy: " + object_.path : "");
+      for (ContactConstraint& c : hands_.contacts)
+        if (c.region) c.region->point = object_.from_source * c.region->point;
+    }
     if (!hands_.empty()) log::info("trajectory.file: hands directed: {}", hands_.describe());
   }
 
   void run(StageIO& io) override {
     save_trajectory_object(object_);
-    const at::Tensor states =
-        at::from_blob(trajectory_.states.data(), {trajectory_.num_frames(), 7}, at::kDouble).to(at::kFloat).contiguous();
+    at::Tensor states = at::from_blob(trajectory_.states.data(), {trajectory_.num_frames(), 7}, at::kDouble);
+    if (object_.moved) states = canonical_states(states, object_.from_source);
+    states = states.to(at::kFloat).contiguous();
     io.out("object", object_.object);
     io.out("object_states", states);
     io.out("fps", trajectory_.fps);

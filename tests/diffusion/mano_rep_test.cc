@@ -122,7 +122,8 @@ TEST(ManoRep, DataSetHoldsTheRepresentationOfItsHandsAndCachesItHonestly) {
   const Sequence seq = read_sequence(s.path);
   const std::array<HandModel, 2> models =
       load_hand_models(posing_hand_model_files()[0], posing_hand_model_files()[1]);
-  const at::Tensor direct = mano_representation({&models[0], &models[1]}, seq.hands, seq.object_states);
+  // The data set's states: the object in its canonical pose (core/object/canonical_frame.h).
+  const at::Tensor direct = mano_representation({&models[0], &models[1]}, seq.hands, s.states);
   EXPECT_LT((b.mano[0] - direct.slice(0, 0, 64)).abs().max().item<double>(), 1e-6);
 
   // Read back from the cache; a data set that does not ask for it reads the same files.

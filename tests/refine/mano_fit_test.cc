@@ -77,6 +77,56 @@ TEST(ManoFit, KeepsEveryJointWithinItsRangeOnCorruptedKeypoints) {
   EXPECT_GT(worst(fit_mano(models, H, off)), 20.0);
 }
 
+// The largest finger-order shortfall (core/hand/finger_order.h, m) over a motion's hands
+// and frames: > 0 where neighbouring fingers are closer across the hand than the gap or
+// crossed.
+double worst_finger_shortfall(const std::array<const HandModel*, 2>& models, const HandMotion& m, double gap) {
+  const PosedHands p = pose_hands(models, m);
+  const at::Tensor J = p.joints.to(at::kDouble).contiguous(), V = p.vertices.to(at::kDouble).contiguous();
+  double worst = -1;
+  for (int h = 0; h < 2; ++h)
+    for (int64_t t = 0; t < J.size(1); ++t) {
+      double joints[16][3], tips[5][3], r[kFingerOrderResiduals];
+      for (int j = 0; j < 16; ++j)
+        for (int k = 0; k < 3; ++k) joints[j][k] = J[h][t][j][k].item<double>();
+      for (int f = 0; f < 5; ++f)
+        for (int k = 0; k < 3; ++k) tips[f][k] = V[h][t][models[h]->fingertips[f]][k].item<double>();
+      finger_order_shortfall<double>(joints, tips, gap, r);
+      for (double v : r) worst = std::max(worst, v);
+    }
+  return worst;
+}
+
+// Keypoints whose index finger lies on the middle finger (its middle and last phalanges
+// moved 24 mm across the hand, as a diffusion model's blurred fingers come): without the
+// finger-order term the fit crosses the two fingers, with it they stay side by side.
+TEST(ManoFit, KeepsTheFingersSideBySideOnOverlappingKeypoints) {
+  const auto& models = test::shipped_hands();
+  const int N = 6;
+  const HandMotion truth = test::known_motion(models, N, /*seed=*/7);
+  EXPECT_LT(worst_finger_shortfall(models, truth, kFingerGap), 0.0) << "the known motion keeps the gap";
+  at::Tensor H = test::noisy_keypoints(models, truth, 0.0, 0).to(at::kDouble).contiguous();
+  const at::Tensor J = pose_hands(models, truth).joints.to(at::kDouble);
+  for (int h = 0; h < 2; ++h) {
+    const std::vector<int> ids = model_keypoints(*models[h]), part = hand_parts(*models[h]);
+    for (int t = 0; t < N; ++t) {
+      const at::Tensor l = J[h][t][1] - J[h][t][7];
+      const at::Tensor shift = -0.024 * l / l.norm();  // onto the middle finger
+      for (std::size_t k = 0; k < ids.size(); ++k)
+        if (part[static_cast<std::size_t>(ids[k])] == 2 || part[static_cast<std::size_t>(ids[k])] == 3)
+          H[h][t][static_cast<int64_t>(k)] += shift;
+    }
+  }
+  ManoFitOptions off;
+  const double crossed = worst_finger_shortfall(models, fit_mano(models, H.to(at::kFloat), off), kFingerGap);
+  ManoFitOptions on;
+  on.w_fingers = 100;
+  const double kept = worst_finger_shortfall(models, fit_mano(models, H.to(at::kFloat), on), kFingerGap);
+  std::printf("largest shortfall: %.1f mm without the term, %.1f mm with it\n", crossed * 1000, kept * 1000);
+  EXPECT_GT(crossed, kFingerGap);  // past each other
+  EXPECT_LT(kept, 0.001);
+}
+
 TEST(ManoFit, RejectsBadInput) {
   const auto& models = test::shipped_hands();
   EXPECT_THROW(fit_mano(models, at::zeros({2, 4, 99, 3})), Error);
