@@ -7,6 +7,7 @@
 
 #include "core/geometry/rotation.h"
 #include "core/object/mesh_repair.h"
+#include "core/object/object_state.h"
 
 namespace bimart {
 
@@ -52,31 +53,20 @@ CanonicalObject to_canonical(const ArticulatedObject& object) {
   if (angle < 1e-9 && pose.translation().norm() < 1e-9 * extent) return c;
   c.from_source = pose;
   c.moved = true;
-  for (TriangleMesh* m : {&c.object.top, &c.object.bottom}) {
-    const Eigen::Matrix3d R = pose.linear();
-    m->vertices = (m->vertices * R.transpose()).rowwise() + pose.translation().transpose();
-  }
+  for (TriangleMesh* m : {&c.object.top, &c.object.bottom}) m->vertices = transform_vertices(pose, m->vertices);
   return c;
 }
 
 at::Tensor canonical_states(const at::Tensor& states, const Eigen::Isometry3d& from_source) {
-  const at::Tensor s = states.to(at::kCPU, at::kDouble).contiguous();
-  const std::int64_t n = s.size(0);
-  at::Tensor out = s.clone();
-  const double* in = s.data_ptr<double>();
-  double* o = out.data_ptr<double>();
+  at::Tensor out = states.to(at::kCPU, at::kDouble).contiguous().clone();
+  double* rows = out.data_ptr<double>();
   const Eigen::Isometry3d back = from_source.inverse();
-  for (std::int64_t t = 0; t < n; ++t) {
-    const double* r = in + 7 * t;
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = axis_angle_to_matrix(Eigen::Vector3d(r[1], r[2], r[3]));
-    T.translation() = Eigen::Vector3d(r[4], r[5], r[6]);
-    const Eigen::Isometry3d U = T * back;
-    const Eigen::Vector3d aa = matrix_to_axis_angle(U.linear());
-    for (int k = 0; k < 3; ++k) {
-      o[7 * t + 1 + k] = aa[k];
-      o[7 * t + 4 + k] = U.translation()[k];
-    }
+  for (std::int64_t t = 0; t < out.size(0); ++t) {
+    ObjectState s = ObjectState::from_row(rows + 7 * t);
+    const Eigen::Isometry3d U = canonical_to_world(s) * back;
+    s.root_rotation = matrix_to_axis_angle(U.linear());
+    s.root_translation = U.translation();
+    Eigen::Map<Eigen::Matrix<double, 7, 1>>(rows + 7 * t) = s.to_row();
   }
   return out.to(states.scalar_type());
 }

@@ -74,7 +74,7 @@ struct JointLimitCost {
   }
 };
 
-// Fingers side by side (core/hand/finger_order.h): scale · max(0, shortfall), 9 per frame.
+// Fingers side by side (core/hand/finger_order.h): scale · max(0, shortfall), 8 per frame.
 struct FingerOrderCost {
   const LbsSubset* tips;  // the five fingertip vertices
   double gap, scale;
