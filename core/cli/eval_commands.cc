@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include <ATen/ATen.h>
@@ -22,6 +23,7 @@
 #include "core/cli/command.h"
 #include "core/cli/sequence_files.h"
 #include "core/io/sequence.h"
+#include "core/metrics/frame_report.h"
 #include "core/metrics/hand_vertices.h"
 #include "core/metrics/metrics_json.h"
 #include "core/metrics/multimodality.h"
@@ -43,6 +45,7 @@ namespace fs = std::filesystem;
 
 struct SetResult : MetricsSet {
   std::string label;
+  std::vector<std::string> frame_csv;  // per evaluated file, its --frames rows (when asked)
 };
 
 SequenceData sequence_data(const Sequence& s, bool keypoints) {
@@ -67,14 +70,14 @@ std::string trajectory_key(const Sequence& s, const std::string& object_path) {
 }
 
 SetResult evaluate_set(const std::string& label, const std::string& folder, const std::string& split,
-                       int threads, bool keep_going, ObjectCache& objects) {
+                       int threads, bool keep_going, ObjectCache& objects, bool frame_rows) {
   SetResult r;
   r.label = label;
   r.folder = folder;
   std::vector<std::string> files = sequence_files(folder, split);
   const size_t total = files.size();
   std::vector<SequenceMetrics> sequences(total);
-  std::vector<std::string> all_keys(total), errors(total);
+  std::vector<std::string> all_keys(total), errors(total), csv(total);
   {
     ProgressBar bar(label, total, true);
     parallel_for(total, threads, [&](size_t i) {
@@ -82,7 +85,17 @@ SetResult evaluate_set(const std::string& label, const std::string& folder, cons
         const Sequence s = read_sequence(files[i]);
         const auto entry = sequence_object(objects, s, files[i]);
         try {
-          sequences[i] = evaluate_sequence(entry->object, *entry->distance, sequence_data(s, true));
+          const SequenceData d = sequence_data(s, true);
+          sequences[i] = evaluate_sequence(entry->object, *entry->distance, d);
+          if (frame_rows) {
+            const auto hands = posing_hand_models();
+            std::ostringstream rows;
+            write_frame_rows_csv(rows, fs::relative(files[i], folder).string(),
+                                 hand_frame_rows(*entry->distance, d.object_states, d.hand_vertices,
+                                                 {&(*hands)[0], &(*hands)[1]}),
+                                 false);
+            csv[i] = rows.str();
+          }
         } catch (const Error& e) {
           throw in_sequence_file(files[i], e);
         }
@@ -105,6 +118,7 @@ SetResult evaluate_set(const std::string& label, const std::string& folder, cons
     }
     r.files.push_back(files[i]);
     r.sequences.push_back(sequences[i]);
+    r.frame_csv.push_back(std::move(csv[i]));
     keys.push_back(all_keys[i]);
   }
   const size_t n = r.files.size();
@@ -163,7 +177,7 @@ void print_table(const std::vector<SetResult>& sets) {
 }
 
 struct EvalOptions {
-  std::string folder, ground_truth, split, json, mano_left, mano_right;
+  std::string folder, ground_truth, split, json, mano_left, mano_right, frames;
   bool keep_going = false;
 };
 
@@ -172,15 +186,28 @@ int eval(const EvalOptions& o) {
     throw Error("bimart eval: give a folder of sequences and/or --ground-truth DATASET");
   const int threads = resolve_threads(0);  // the global --threads, else all cores
   if (!o.json.empty()) check_output_file(o.json);
+  if (!o.frames.empty()) check_output_file(o.frames);
   // One sequence per thread: libtorch's own intra-op threads would only oversubscribe.
   runtime::set_threads(1);
   if (!o.mano_left.empty() || !o.mano_right.empty()) set_posing_hand_models(o.mano_left, o.mano_right);
   ObjectCache objects;
   std::vector<SetResult> sets;
-  if (!o.folder.empty()) sets.push_back(evaluate_set("generated", o.folder, o.split, threads, o.keep_going, objects));
+  if (!o.folder.empty()) sets.push_back(evaluate_set("generated", o.folder, o.split, threads, o.keep_going, objects, !o.frames.empty()));
   if (!o.ground_truth.empty())
-    sets.push_back(evaluate_set("ground truth", o.ground_truth, o.split, threads, o.keep_going, objects));
+    sets.push_back(evaluate_set("ground truth", o.ground_truth, o.split, threads, o.keep_going, objects, !o.frames.empty()));
   print_table(sets);
+  if (!o.frames.empty()) {
+    write_file_atomically(o.frames, [&](std::ostream& out) {
+      out << "set,";
+      write_frame_rows_csv(out, "", {}, true);
+      for (const auto& s : sets)
+        for (const auto& rows : s.frame_csv) {
+          std::istringstream in(rows);
+          for (std::string line; std::getline(in, line);) out << (s.label == "generated" ? "generated," : "ground_truth,") << line << "\n";
+        }
+    });
+    std::cout << "wrote " << o.frames << "\n";
+  }
   size_t skipped = 0;
   for (const auto& s : sets) skipped += s.skipped.size();
   if (!o.json.empty()) {
@@ -210,6 +237,9 @@ void add_eval_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--split", o.split,
                   "only the files listed under this key of <folder>/manifest.json (e.g. test)");
   cmd->add_option("--json", o.json, "also write the results (table and per-sequence counts) to this JSON file");
+  cmd->add_option("--frames", o.frames,
+                  "also write one CSV row per frame and hand: depth in the object, the deepest vertex's joint and "
+                  "part, cavity depth, why implausible (docs/metrics.md)");
   cmd->add_option("--mano-left", o.mano_left, "left hand model .npz to pose the hands with (default: the shipped hand)");
   cmd->add_option("--mano-right", o.mano_right, "right hand model .npz (give both; e.g. converted MANO for ARCTIC data)");
   cmd->add_flag("--keep-going", o.keep_going,

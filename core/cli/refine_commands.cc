@@ -275,6 +275,10 @@ void add_refine_commands(CLI::App& app, Commands& out) {
       ->capture_default_str();
   cmd->add_option("--w-pose", o.refine.w_pose, "refinement: finger pose held near the fit's (0 = off)")
       ->capture_default_str();
+  cmd->add_option("--w-separation", o.refine.w_separation, "refinement: two fingers' bones kept apart (0 = off)")
+      ->capture_default_str();
+  cmd->add_option("--fit-w-separation", o.fit.w_separation, "MANO fit: two fingers' bones kept apart (0 = off)")
+      ->capture_default_str();
   cmd->add_option("--fit-w-limits", o.fit.w_limits, "MANO fit: anatomical joint-limit weight (0 = off)")
       ->capture_default_str();
   cmd->add_option("--fit-w-fingers", o.fit.w_fingers, "MANO fit: fingers side by side across the hand (0 = off)")

@@ -208,9 +208,7 @@ void add_object(Builder& b, Animation& anim, const ArticulatedObject& object, co
   anim.channel(b, root_id, "translation", translation, TINYGLTF_TYPE_VEC3);
 }
 
-constexpr std::array<const char*, HandModel::kNumJoints> kJointNames = {
-    "wrist",   "index1", "index2", "index3", "middle1", "middle2", "middle3", "pinky1",
-    "pinky2",  "pinky3", "ring1",  "ring2",  "ring3",   "thumb1",  "thumb2",  "thumb3"};
+constexpr auto& kJointNames = HandModel::kJointNames;
 
 int add_hand(Builder& b, Animation& anim, const HandModel& m, const HandParams& params, int h,
              const GltfOptions& options, GltfSummary& summary, std::vector<int>& roots) {

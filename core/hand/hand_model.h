@@ -31,6 +31,10 @@ struct HandModel {
   static constexpr int kNumBetas = 10;
   static constexpr int kNumPoseFeatures = 135;  // 15 joints x 9
   static constexpr int kPoseDim = 45;           // 15 joints x 3 (axis-angle)
+  // Joint names in MANO order (glTF nodes, per-frame reports).
+  static constexpr std::array<const char*, kNumJoints> kJointNames = {
+      "wrist",  "index1", "index2", "index3", "middle1", "middle2", "middle3", "pinky1",
+      "pinky2", "pinky3", "ring1",  "ring2",  "ring3",   "thumb1",  "thumb2",  "thumb3"};
 
   int num_vertices() const;
   int num_faces() const;

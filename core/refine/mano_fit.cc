@@ -93,6 +93,25 @@ ceres::CostFunction* finger_order_cost(const LbsSubset& tips, const ManoFitOptio
       new FingerOrderCost{&tips, opt.finger_gap, std::sqrt(opt.w_fingers * kJ)});
 }
 
+// Fingers apart (core/hand/finger_separation.h): scale · max(0, gap − distance), 90 per frame.
+struct FingerSeparationCost {
+  const LbsSubset* tips;  // the five fingertip vertices
+  double gap, scale;
+  template <class T>
+  bool operator()(const T* x, const T* beta, T* r) const {
+    T tip[5][3], J[HandModel::kNumJoints][3];
+    lbs_subset(*tips, x, x + 3, x + 48, beta, &tip[0][0], &J[0][0]);
+    finger_separation_shortfall<T>(J, tip, gap, r);
+    for (int i = 0; i < kFingerSeparationResiduals; ++i) r[i] *= T(scale);
+    return true;
+  }
+};
+
+ceres::CostFunction* finger_separation_cost(const LbsSubset& tips, const ManoFitOptions& opt) {
+  return new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, kX, kB>(
+      new FingerSeparationCost{&tips, opt.separation_gap, std::sqrt(opt.w_separation * kJ)});
+}
+
 ceres::CostFunction* joint_limit_cost(const JointLimits& limits, double w_limits) {
   return new ceres::AutoDiffCostFunction<JointLimitCost, HandModel::kPoseDim, kX>(
       new JointLimitCost{&limits, std::sqrt(w_limits * kJ) * kLeverFinger});
@@ -198,6 +217,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                          nullptr, x);
       if (opt.w_limits > 0) p.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
       if (opt.w_fingers > 0) p.AddResidualBlock(finger_order_cost(tips, opt), nullptr, x, beta->data());
+      if (opt.w_separation > 0) p.AddResidualBlock(finger_separation_cost(tips, opt), nullptr, x, beta->data());
       p.SetParameterBlockConstant(beta->data());
       ceres::Solver::Summary s;
       solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
@@ -214,6 +234,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                              nullptr, x);
     if (opt.w_limits > 0) problem.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
     if (opt.w_fingers > 0) problem.AddResidualBlock(finger_order_cost(tips, opt), nullptr, x, beta->data());
+    if (opt.w_separation > 0) problem.AddResidualBlock(finger_separation_cost(tips, opt), nullptr, x, beta->data());
     if (t > 0)
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SmoothCost, kX, kX, kX>(
                                    new SmoothCost{std::sqrt(opt.w_smooth * kJ)}),
@@ -260,6 +281,8 @@ void ManoFitOptions::validate() const {
   nonneg(w_limits, "w_limits");
   nonneg(w_fingers, "w_fingers");
   nonneg(finger_gap, "finger_gap");
+  nonneg(w_separation, "w_separation");
+  nonneg(separation_gap, "separation_gap");
   if (warm_start_iterations < 0) throw Error("mano fit: warm_start_iterations must be >= 0");
   if (max_iterations < 0) throw Error("mano fit: max_iterations must be >= 0");
   if (threads < 0) throw Error("mano fit: threads must be >= 0 (0 = all cores)");

@@ -31,6 +31,7 @@
 #include "core/hand/hand_model.h"
 #include "core/hand/keypoints.h"  // model_keypoints
 #include "core/hand/finger_order.h"
+#include "core/hand/finger_separation.h"
 #include "core/hand/hand_motion.h"
 
 namespace bimart {
@@ -46,6 +47,10 @@ struct ManoFitOptions {
   // 0 = off.
   double w_fingers = 0;
   double finger_gap = kFingerGap;  // m
+  // Fingers apart (core/hand/finger_separation.h): two fingers' bones 1 mm inside the gap
+  // cost as much as all 100 keypoints √w_separation mm off. 0 = off.
+  double w_separation = 0;
+  double separation_gap = kFingerSeparation;  // m
   bool fit_shape = true;   // false: β stays 0
   int warm_start_iterations = 3;  // per frame, sequentially
   int max_iterations = 30;        // the joint solve

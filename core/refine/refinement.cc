@@ -16,6 +16,7 @@
 
 #include "core/features/hand_features.h"
 #include "core/geometry/point_guard.h"
+#include "core/hand/finger_separation.h"
 #include "core/hand/joint_limits.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
@@ -77,6 +78,8 @@ struct HandData {
   double s_limits = 0;
   std::vector<double> p_start;  // [N × 51] the start's parameters (w_pose), s_pose √(2 w_pose / N) · ℓ_f
   double s_pose = 0;
+  LbsSubset tips;    // the five fingertip vertices (w_separation), residual scale √(2 w_separation / N)
+  double s_sep = 0;
   // What Ceres optimises, [N × 51]: x itself, or with RefineOptions::joint_angles x with
   // each finger joint's axis-angle as its three bounded angles (JointLimits::rotation).
   bool angles = false;
@@ -123,6 +126,40 @@ struct FingerLimitCost {
     return true;
   }
 };
+
+// Fingers apart in one frame (core/hand/finger_separation.h), from its five finger blocks
+// (axis-angles, or bounded angles): distances within the hand do not depend on the global
+// rotation and translation, so they stay out of the block.
+struct FingerSeparationCost {
+  const HandData* d;
+  double gap, scale;
+  template <class T>
+  bool operator()(const T* f0, const T* f1, const T* f2, const T* f3, const T* f4, T* r) const {
+    T p[kX], x[kX];
+    for (int i = 0; i < kX; ++i) p[i] = T(0);
+    const T* fingers[5] = {f0, f1, f2, f3, f4};
+    for (int g = 0; g < 5; ++g) std::copy(fingers[g], fingers[g] + 9, p + 3 + 9 * g);
+    state_of(*d, p, x);
+    T tip[5][3], J[HandModel::kNumJoints][3];
+    lbs_subset(d->tips, x, x + 3, x + 48, d->beta.data(), &tip[0][0], &J[0][0]);
+    finger_separation_shortfall<T>(J, tip, gap, r);
+    for (int i = 0; i < kFingerSeparationResiduals; ++i) r[i] *= T(scale);
+    return true;
+  }
+};
+
+// Σ_t Σ_pairs max(0, gap − d)² (m²) of the hand's current poses.
+double separation_sum(const HandData& d, double gap) {
+  double sum = 0;
+  double tip[5][3], J[HandModel::kNumJoints][3], r[kFingerSeparationResiduals];
+  for (int64_t t = 0; t < d.N; ++t) {
+    const double* x = d.x.data() + t * kX;
+    lbs_subset(d.tips, x, x + 3, x + 48, d.beta.data(), &tip[0][0], &J[0][0]);
+    finger_separation_shortfall<double>(J, tip, gap, r);
+    for (double v : r) sum += v * v;
+  }
+  return sum;
+}
 
 // Σ_t Σ_j ||excess||² (rad²) of the hand's current poses.
 double limit_excess_sum(const HandData& d) {
@@ -562,6 +599,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     }
     e.terms.pose = o.w_pose * kLeverFinger * kLeverFinger * sq / static_cast<double>(N);
   }
+  if (o.w_separation > 0) e.terms.separation = o.w_separation * separation_sum(*d, o.separation_gap) / static_cast<double>(N);
   e.terms.acc = N > 2 ? o.w_acc * acc / static_cast<double>((N - 2) * static_cast<int64_t>(d->acc_ids.size())) : 0.0;
   e.keypoint_error = kerr / nk;
   return e;
@@ -692,6 +730,8 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   d->s_pin = std::sqrt(2 * w_pin);
   d->s_limits = std::sqrt(2 * o.w_limits / static_cast<double>(d->N)) * kLeverFinger;
   d->s_pose = std::sqrt(2 * o.w_pose / static_cast<double>(d->N)) * kLeverFinger;
+  d->s_sep = std::sqrt(2 * o.w_separation / static_cast<double>(d->N));
+  d->tips = LbsSubset::from(*d->model, std::vector<int>(d->model->fingertips.begin(), d->model->fingertips.end()));
   d->p_start.resize(d->x.size());
   for (int64_t t = 0; t < d->N; ++t) params_of(*d, d->x.data() + t * kX, d->p_start.data() + t * kX);
   for (int p : d->hold_part) rep->held_frames += p >= 0;
@@ -738,6 +778,11 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         for (int g = 0; g < 5; ++g)
           problem.AddResidualBlock(new ValuePinCost<9>(d->p_start.data() + t * kX + 3 + 9 * g, d->s_pose), nullptr,
                                    x + 3 + 9 * g);
+      if (o.w_separation > 0 && !d->is_kept(t))
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, 9, 9, 9, 9, 9>(
+                new FingerSeparationCost{d, o.separation_gap, d->s_sep}),
+            nullptr, x + 3, x + 12, x + 21, x + 30, x + 39);
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {
         const std::vector<Block> blocks = blocks_of(mask);
@@ -920,6 +965,8 @@ void RefineOptions::validate() const {
   nonneg(w_hold, "w_hold");
   nonneg(w_limits, "w_limits");
   nonneg(w_pose, "w_pose");
+  nonneg(w_separation, "w_separation");
+  nonneg(separation_gap, "separation_gap");
   nonneg(pen_margin, "pen_margin");
   if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
@@ -982,10 +1029,10 @@ std::string format_refine_report(const RefineReport& r) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
         "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}, "
-        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped), pose {:.3g}; {} steps cut back; "
+        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped), pose {:.3g}, separation {:.3g} -> {:.3g}; {} steps cut back; "
         "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
-        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.after.pose, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.after.pose, x.before.separation, x.after.separation, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
         x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;

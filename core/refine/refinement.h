@@ -11,6 +11,7 @@
 //   w_limits · Σ_{t,j} ||0.03 m · excess_tj||² / N       anatomical joint limits (ours; core/hand/joint_limits.h),
 //                                                         with every joint clamped into its range after each round
 //   w_pose · Σ_t ||0.03 m · (θ_t − θ_fit,t)||² / N       finger pose near the fit's (ours)
+//   w_separation · Σ_t Σ_pairs max(0, gap − d)² / N      two fingers' bones apart (ours; core/hand/finger_separation.h)
 // The paper sums unsquared distances and takes 100 gradient steps; a least-squares solver
 // converges, so it squares them and adds the fit term to hold what the other terms leave
 // free (a contact constrains a keypoint along the surface normal only). Its weights
@@ -89,6 +90,12 @@ struct RefineOptions {
   // refinement curled fingers into fists (Implaus 98 %); with 1e4, 10 %, and Pen 5mm
   // 38 → 31 %. pipelines/bimart.yaml sets 1e4.
   double w_pose = 0;
+  // Fingers apart (ours; 0 = the paper's, the library default): w_separation ·
+  // Σ_t Σ max(0, gap − distance)² / N over the bone pairs of two different fingers
+  // (core/hand/finger_separation.h), so fingers pushed out of the object do not end inside
+  // each other.
+  double w_separation = 0;
+  double separation_gap = 0.010;  // m (kFingerSeparation)
   // Finger joints as bounded angles (ours, off by default): each joint's flexion, abduction
   // and twist (JointLimits::rotation) are the solver's parameters, bounded by their
   // anatomical ranges, so every step stays inside them (the thumb's box corners, outside its
@@ -139,8 +146,8 @@ struct RefineDirections {
 
 // The terms of the cost as defined above, weighted, with exact surface distances.
 struct RefineTerms {
-  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0, limits = 0, pose = 0;
-  double total() const { return proj + pen + acc + fit + hold + pin + limits + pose; }
+  double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, pin = 0, limits = 0, pose = 0, separation = 0;
+  double total() const { return proj + pen + acc + fit + hold + pin + limits + pose + separation; }
 };
 struct RefineHandReport {
   RefineTerms before, after;

@@ -51,6 +51,9 @@ class CeresRefineStage : public Refiner {
             .param("w_pose", d.w_pose,
                    "finger pose held near the fit's: penetration resolved by moving the hand, not curling fingers "
                    "(ours; 0 = off, the paper's)")
+            .param("w_separation", d.w_separation,
+                   "fingers apart: two fingers' bones at least separation_gap apart (ours; 0 = off, the paper's)")
+            .param("separation_gap", d.separation_gap, "m, the least distance between two fingers' bone axes")
             .param("joint_angles", d.joint_angles,
                    "finger joints as angles bounded by their anatomical ranges (ours; false: axis-angles, the paper's)")
             .param("backtrack", d.backtrack,
@@ -81,6 +84,8 @@ class CeresRefineStage : public Refiner {
     o_.w_hold = p.number("w_hold");
     o_.w_limits = p.number("w_limits");
     o_.w_pose = p.number("w_pose");
+    o_.w_separation = p.number("w_separation");
+    o_.separation_gap = p.number("separation_gap");
     o_.joint_angles = p.boolean("joint_angles");
     o_.backtrack = p.boolean("backtrack");
     o_.validate();

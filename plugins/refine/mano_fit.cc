@@ -25,6 +25,9 @@ class ManoFitStage : public Refiner {
                       .param("w_fingers", d.w_fingers,
                              "fingers side by side: index, middle, ring, pinky in order across the hand (0: off)")
                       .param("finger_gap", d.finger_gap, "m, the least lateral gap between neighbouring fingers")
+                      .param("w_separation", d.w_separation,
+                             "fingers apart: two fingers' bones at least separation_gap apart (0: off)")
+                      .param("separation_gap", d.separation_gap, "m, the least distance between two fingers' bone axes")
                       .param("fit_shape", d.fit_shape, "fit β (false: β = 0)")
                       .param("warm_start_iterations", d.warm_start_iterations, "solver steps per frame, frame by frame")
                       .param("max_iterations", d.max_iterations, "solver steps of the joint solve over all frames")
@@ -40,6 +43,8 @@ class ManoFitStage : public Refiner {
     o_.w_limits = p.number("w_limits");
     o_.w_fingers = p.number("w_fingers");
     o_.finger_gap = p.number("finger_gap");
+    o_.w_separation = p.number("w_separation");
+    o_.separation_gap = p.number("separation_gap");
     o_.fit_shape = p.boolean("fit_shape");
     o_.warm_start_iterations = static_cast<int>(p.integer("warm_start_iterations"));
     o_.max_iterations = static_cast<int>(p.integer("max_iterations"));

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
+#include <vector>
 
 #include <ATen/ATen.h>
 #include <nlohmann/json.hpp>
@@ -133,6 +135,53 @@ TEST(EvalCli, TableAndJsonOnATinyFolder) {
   const CliRun empty = run_cli((dir / "objects").string());
   EXPECT_NE(empty.status, 0);
   EXPECT_NE(empty.output.find("no .npz"), std::string::npos) << empty.output;
+  fs::remove_all(dir);
+}
+
+// --frames: one row per frame and hand, and the rows say what the table counts — the frames
+// with a row deeper than 5 mm are Pen 5mm's. The right hand sinks 3 cm per frame through
+// the box (all its vertices at one point), the left stays half a metre away.
+TEST(EvalCli, FramesCsvHasARowPerFrameAndHandThatAgreesWithPen) {
+  const fs::path dir = fs::temp_directory_path() / ("bimart_eval_frames_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  save_object(make_object("box", 1), (dir / "objects" / "box").string());
+  const int64_t n = 8;
+  Sequence s = sequence("sink", at::zeros({n, 7}), 0.0);
+  for (int64_t t = 0; t < n; ++t) s.hands.vertices[1][t].select(1, 1).fill_(0.2 - 0.03 * static_cast<double>(t));
+  write_sequence(s, (dir / "gen" / "sink.npz").string());
+  const fs::path csv = dir / "frames.csv", json = dir / "eval.json";
+  const CliRun r = run_cli((dir / "gen").string() + " --frames " + csv.string() + " --json " + json.string() + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "set,sequence,frame,hand,depth_mm,vertex,region,part,through,cavity_mm,closest_fingers_mm,implausible");
+  int rows = 0, deep_frames = 0, inside = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
+    ASSERT_GE(f.size(), 11u) << line;
+    EXPECT_EQ(f[0], "generated");
+    EXPECT_EQ(f[1], "sink.npz");
+    const double depth = std::stod(f[4]);
+    if (f[3] == "left") EXPECT_LT(depth, -100.0) << line;  // half a metre off
+    if (depth > 0) {
+      ++inside;
+      EXPECT_EQ(f[3], "right");
+      EXPECT_EQ(f[5], "0") << line;  // all vertices at one point: the first is the deepest
+      EXPECT_FALSE(f[6].empty());
+    }
+    if (f[3] == "right" && depth > 5.0) ++deep_frames;
+  }
+  EXPECT_EQ(rows, 2 * n);
+  EXPECT_GT(inside, 0);
+  nlohmann::json j;
+  std::ifstream(json) >> j;
+  EXPECT_EQ(j["generated"]["metrics"][3]["name"], "Pen 5mm");
+  EXPECT_EQ(j["generated"]["metrics"][3]["numerator"].get<int>(), deep_frames);
+  EXPECT_GT(deep_frames, 0);
   fs::remove_all(dir);
 }
 

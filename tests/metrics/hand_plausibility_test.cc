@@ -6,6 +6,13 @@
 
 #include <ATen/ATen.h>
 
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/squared_distance_3.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/hand/finger_separation.h"
 #include "core/hand/lbs.h"
 #include "core/metrics/hand_plausibility.h"
 #include "core/synth/grasp.h"
@@ -89,6 +96,55 @@ TEST(HandPlausibility, FramesOfPosedVerticesCountAFrameWithOneBadHand) {
   EXPECT_EQ(c.frames, 3);
   EXPECT_EQ(c.hits, 1);
   EXPECT_NE(why.find("frame 1, right hand: index PIP"), std::string::npos) << why;
+}
+
+// The separation term's segment distance (written out for Ceres Jets) against CGAL's, which
+// the measure uses: random segments, including parallel ones and ones that cross.
+TEST(FingerSeparation, SegmentDistanceAgreesWithCgal) {
+  using K = CGAL::Simple_cartesian<double>;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  double worst = 0;
+  for (int i = 0; i < 2000; ++i) {
+    double p0[3], p1[3], q0[3], q1[3];
+    for (int k = 0; k < 3; ++k) {
+      p0[k] = u(rng), p1[k] = u(rng), q0[k] = u(rng), q1[k] = u(rng);
+    }
+    if (i % 4 == 1)  // parallel
+      for (int k = 0; k < 3; ++k) q1[k] = q0[k] + 0.7 * (p1[k] - p0[k]);
+    if (i % 4 == 2)  // crossing: q passes through p's midpoint
+      for (int k = 0; k < 3; ++k) q1[k] = 2 * (0.5 * (p0[k] + p1[k])) - q0[k];
+    const K::Segment_3 a(K::Point_3(p0[0], p0[1], p0[2]), K::Point_3(p1[0], p1[1], p1[2]));
+    const K::Segment_3 b(K::Point_3(q0[0], q0[1], q0[2]), K::Point_3(q1[0], q1[1], q1[2]));
+    const double expected = std::sqrt(CGAL::to_double(CGAL::squared_distance(a, b)));
+    worst = std::max(worst, std::abs(segment_distance(p0, p1, q0, q1) - expected));
+  }
+  EXPECT_LT(worst, 1e-8);  // m (the 1e-18 m² under the root: 1e-9 m where the segments meet)
+}
+
+// Shortfall and measure agree: a grasp keeps every pair apart (all zero), fingers crossed
+// as the measure's test crosses them leave a pair short by more than the gap minus the
+// measure's threshold.
+TEST(FingerSeparation, ShortfallIsZeroForAGraspAndPositiveForCrossedFingers) {
+  for (int h = 0; h < 2; ++h) {
+    const HandModel& m = *test::shipped_hands()[static_cast<std::size_t>(h)];
+    const auto shortfall = [&](const Eigen::VectorXd& fingers) {
+      const Posed p = pose(h, fingers);
+      double J[16][3], tips[5][3], r[kFingerSeparationResiduals];
+      for (int j = 0; j < 16; ++j)
+        for (int k = 0; k < 3; ++k) J[j][k] = p.r.joints(j, k);
+      for (int f = 0; f < 5; ++f)
+        for (int k = 0; k < 3; ++k) tips[f][k] = p.tips(f, k);
+      finger_separation_shortfall<double>(J, tips, kFingerSeparation, r);
+      return *std::max_element(r, r + kFingerSeparationResiduals);
+    };
+    EXPECT_EQ(shortfall(Eigen::VectorXd::Zero(45)), 0.0) << "flat hand " << h;
+    const HandGeometry geo = hand_geometry(m, Eigen::VectorXd::Zero(10));
+    EXPECT_EQ(shortfall(grasp_finger_pose(geo, {0.9, 0.9, 0.9, 0.9, 0.9}, 0.0)), 0.0) << "grasp " << h;
+    Eigen::VectorXd cross = with_joint(h, 1, Eigen::Vector3d(0, -0.35, 0));
+    cross += with_joint(h, 4, Eigen::Vector3d(0, 0.35, 0));
+    EXPECT_GT(shortfall(cross), kFingerSeparation - kCrossedGap) << "crossed " << h;
+  }
 }
 
 }  // namespace

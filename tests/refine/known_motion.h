@@ -9,7 +9,9 @@
 
 #include <ATen/ATen.h>
 
+#include "core/hand/finger_separation.h"
 #include "core/hand/joint_limits.h"
+#include "core/hand/keypoints.h"
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
 
@@ -70,6 +72,43 @@ inline double largest_joint_excess(const std::array<const HandModel*, 2>& models
       worst = std::max(worst, limits.largest_excess(Eigen::Map<const Eigen::VectorXd>(pose[t].data_ptr<double>(), 45)));
   }
   return worst;
+}
+
+// The closest two fingers' bones come over all frames and hands (m).
+inline double closest_fingers(const std::array<const HandModel*, 2>& models, const HandMotion& m) {
+  const PosedHands p = pose_hands(models, m);
+  const at::Tensor J = p.joints.to(at::kDouble).contiguous(), V = p.vertices.to(at::kDouble).contiguous();
+  double closest = 1;
+  for (int h = 0; h < 2; ++h)
+    for (int64_t t = 0; t < J.size(1); ++t) {
+      double joints[16][3], tips[5][3], r[kFingerSeparationResiduals];
+      for (int j = 0; j < 16; ++j)
+        for (int k = 0; k < 3; ++k) joints[j][k] = J[h][t][j][k].item<double>();
+      for (int f = 0; f < 5; ++f)
+        for (int k = 0; k < 3; ++k) tips[f][k] = V[h][t][models[h]->fingertips[f]][k].item<double>();
+      finger_separation_shortfall<double>(joints, tips, 1.0, r);  // gap 1 m: 1 − distance
+      for (double v : r) closest = std::min(closest, 1.0 - v);
+    }
+  return closest;
+}
+
+// Keypoints of `motion` whose index finger's middle and last phalanges (hand parts 2, 3)
+// are moved `shift` (m) across the hand towards the middle finger, as a diffusion model's
+// blurred fingers come; [2, N, 100, 3] float.
+inline at::Tensor merged_keypoints(const std::array<const HandModel*, 2>& models, const HandMotion& motion, double shift) {
+  at::Tensor H = noisy_keypoints(models, motion, 0.0, 0).to(at::kDouble).contiguous();
+  const at::Tensor J = pose_hands(models, motion).joints.to(at::kDouble);
+  for (int h = 0; h < 2; ++h) {
+    const std::vector<int> ids = model_keypoints(*models[h]), part = hand_parts(*models[h]);
+    for (int64_t t = 0; t < H.size(1); ++t) {
+      const at::Tensor l = J[h][t][1] - J[h][t][7];
+      const at::Tensor d = -shift * l / l.norm();
+      for (std::size_t k = 0; k < ids.size(); ++k)
+        if (part[static_cast<std::size_t>(ids[k])] == 2 || part[static_cast<std::size_t>(ids[k])] == 3)
+          H[h][t][static_cast<int64_t>(k)] += d;
+    }
+  }
+  return H.to(at::kFloat);
 }
 
 }  // namespace bimart::test

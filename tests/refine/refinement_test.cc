@@ -1,6 +1,7 @@
 // The refinement (core/refine/refinement.h) on cases with a known answer: a hand pushed
 // into a box comes out, a jittery sequence comes out smoother.
 #include "core/refine/refinement.h"
+#include "core/metrics/hand_plausibility.h"
 
 #include <limits>
 
@@ -279,6 +280,39 @@ TEST(Refinement, WithLimitsEveryJointEndsWithinItsRange) {
   EXPECT_LT(worst(refine_hands(models, distance, states, X, start, penalty, &report)), 1e-3);
   EXPECT_GT(report.hands[0].clamped_joints + report.hands[1].clamped_joints, 0);
   EXPECT_GT(worst(refine_hands(models, distance, states, X, start, off)), 20.0);
+}
+
+// Fingers apart (w_separation): a start whose index and middle fingers' bones touch (the
+// fit to keypoints that merge them) ends with the two at least the gap apart, even with the
+// finger pose held near the start's as the pipelines hold it; without the term they stay.
+TEST(Refinement, SeparationPullsMergedFingersApart) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 6;
+  HandMotion truth = test::known_motion(models, N, 7);
+  for (auto& p : truth.hands) p.trans = p.trans + at::tensor({0.0f, 0.0f, 0.3f});  // far above the slab
+  truth.vertices = pose_hand_vertices(models, truth);
+  const at::Tensor states = at::zeros({N, 7}, at::kFloat);
+  const at::Tensor H = test::merged_keypoints(models, truth, 0.012);
+  const HandMotion start = fit_mano(models, H);
+  const at::Tensor X = keypoint_features(H, object, states);
+  RefineOptions off, on;
+  off.w_pose = on.w_pose = 1e4;
+  on.w_separation = 1e5;
+  RefineReport report;
+  const double before = test::closest_fingers(models, start);
+  const double without = test::closest_fingers(models, refine_hands(models, distance, states, X, start, off));
+  const double with = test::closest_fingers(models, refine_hands(models, distance, states, X, start, on, &report));
+  std::printf("closest fingers: start %.1f mm, refined without %.1f mm, with %.1f mm\n", before * 1e3, without * 1e3,
+              with * 1e3);
+  EXPECT_LT(before, kCrossedGap);
+  EXPECT_LT(without, kCrossedGap);
+  EXPECT_GT(with, kFingerSeparation - 0.001);
+  // The term as reported (the left hand's fit merges them; the right's keeps them apart).
+  const double b = report.hands[0].before.separation + report.hands[1].before.separation;
+  EXPECT_GT(b, 0.0);
+  EXPECT_LT(report.hands[0].after.separation + report.hands[1].after.separation, 0.01 * b);
 }
 
 TEST(Refinement, RejectsMismatchedInput) {
