@@ -17,6 +17,10 @@ namespace bimart {
 
 constexpr double kFingerSeparation = 0.010;  // m, 2 mm over the measure's kCrossedGap
 constexpr int kFingerSeparationResiduals = 90;  // 10 finger pairs × 3 × 3 bones
+// Costs carry the term only in frames whose fingers come within the gap plus this (m) at the
+// start of a solve: most frames have every pair far apart, and their Jets would cost for
+// nothing.
+constexpr double kSeparationActive = 0.005;
 
 // The distance between the segments p0–p1 and q0–q1 (closest points as in Ericson, Real-Time
 // Collision Detection §5.1.9; written out rather than CGAL's squared_distance so Ceres Jets
@@ -52,8 +56,9 @@ T segment_distance(const T* p0, const T* p1, const T* q0, const T* q1) {
 }
 
 // max(0, gap − distance) for every pair of bones of two different fingers; joints [16][3]
-// (MANO order) and tips [5][3] (thumb, index, middle, ring, pinky) of one hand, any scalar
-// type. out has kFingerSeparationResiduals entries.
+// (MANO order; regressed from the vertices as the measure reads them,
+// core/hand/regressed_joints.h) and tips [5][3] (thumb, index, middle, ring, pinky) of one
+// hand, any scalar type. out has kFingerSeparationResiduals entries.
 template <class T>
 void finger_separation_shortfall(const T (*joints)[3], const T (*tips)[3], double gap, T* out) {
   // MANO order: index, middle, pinky, ring, thumb; their first joints and tip rows.

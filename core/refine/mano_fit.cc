@@ -2,6 +2,7 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -16,6 +17,7 @@
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs_subset.h"
 #include "core/hand/lbs_torch.h"
+#include "core/hand/regressed_joints.h"
 #include "core/refine/hand_state.h"
 #include "core/util/error.h"
 #include "core/util/parallel.h"
@@ -93,23 +95,37 @@ ceres::CostFunction* finger_order_cost(const LbsSubset& tips, const ManoFitOptio
       new FingerOrderCost{&tips, opt.finger_gap, std::sqrt(opt.w_fingers * kJ)});
 }
 
-// Fingers apart (core/hand/finger_separation.h): scale · max(0, gap − distance), 90 per frame.
+// Fingers apart (core/hand/finger_separation.h): scale · max(0, gap − distance), 90 per
+// frame, between bones through the joints the measure regresses from the vertices.
 struct FingerSeparationCost {
-  const LbsSubset* tips;  // the five fingertip vertices
+  const LbsSubset* sub;  // RegressedJoints::vertex_ids
+  const RegressedJoints* rj;
   double gap, scale;
   template <class T>
   bool operator()(const T* x, const T* beta, T* r) const {
+    std::vector<T> posed(static_cast<size_t>(3 * sub->size()));
+    lbs_subset(*sub, x, x + 3, x + 48, beta, posed.data());
     T tip[5][3], J[HandModel::kNumJoints][3];
-    lbs_subset(*tips, x, x + 3, x + 48, beta, &tip[0][0], &J[0][0]);
+    rj->apply(posed.data(), J, tip);
     finger_separation_shortfall<T>(J, tip, gap, r);
     for (int i = 0; i < kFingerSeparationResiduals; ++i) r[i] *= T(scale);
     return true;
   }
 };
 
-ceres::CostFunction* finger_separation_cost(const LbsSubset& tips, const ManoFitOptions& opt) {
+// The closest two fingers' bones come in frame state x (m).
+double closest_fingers(const LbsSubset& sub, const RegressedJoints& rj, const double* x, const double* beta) {
+  std::vector<double> posed(static_cast<size_t>(3 * sub.size()));
+  lbs_subset(sub, x, x + 3, x + 48, beta, posed.data());
+  double tip[5][3], J[HandModel::kNumJoints][3], r[kFingerSeparationResiduals];
+  rj.apply(posed.data(), J, tip);
+  finger_separation_shortfall<double>(J, tip, 1.0, r);  // gap 1 m: 1 − distance
+  return 1.0 - *std::max_element(r, r + kFingerSeparationResiduals);
+}
+
+ceres::CostFunction* finger_separation_cost(const LbsSubset& sub, const RegressedJoints& rj, const ManoFitOptions& opt) {
   return new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, kX, kB>(
-      new FingerSeparationCost{&tips, opt.separation_gap, std::sqrt(opt.w_separation * kJ)});
+      new FingerSeparationCost{&sub, &rj, opt.separation_gap, std::sqrt(opt.w_separation * kJ)});
 }
 
 ceres::CostFunction* joint_limit_cost(const JointLimits& limits, double w_limits) {
@@ -189,6 +205,12 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   const double prior_scale = std::sqrt(opt.w_pose * kJ) * kLeverFinger;
   const JointLimits limits(model);
   const LbsSubset tips = LbsSubset::from(model, std::vector<int>(model.fingertips.begin(), model.fingertips.end()));
+  const RegressedJoints rj = RegressedJoints::from(model);
+  const LbsSubset rj_sub = LbsSubset::from(model, rj.vertex_ids);
+  // A frame whose fingers come near the gap carries the separation term (kSeparationActive).
+  const auto near_gap = [&](const double* x) {
+    return opt.w_separation > 0 && closest_fingers(rj_sub, rj, x, beta->data()) < opt.separation_gap + kSeparationActive;
+  };
 
   auto palm_points = [&](const double* v300) {
     Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(palm.size()));
@@ -217,10 +239,13 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                          nullptr, x);
       if (opt.w_limits > 0) p.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
       if (opt.w_fingers > 0) p.AddResidualBlock(finger_order_cost(tips, opt), nullptr, x, beta->data());
-      if (opt.w_separation > 0) p.AddResidualBlock(finger_separation_cost(tips, opt), nullptr, x, beta->data());
       p.SetParameterBlockConstant(beta->data());
       ceres::Solver::Summary s;
       solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
+      if (near_gap(x)) {  // again, with the fingers held apart
+        p.AddResidualBlock(finger_separation_cost(rj_sub, rj, opt), nullptr, x, beta->data());
+        solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
+      }
     }
   }
 
@@ -234,7 +259,6 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                              nullptr, x);
     if (opt.w_limits > 0) problem.AddResidualBlock(joint_limit_cost(limits, opt.w_limits), nullptr, x);
     if (opt.w_fingers > 0) problem.AddResidualBlock(finger_order_cost(tips, opt), nullptr, x, beta->data());
-    if (opt.w_separation > 0) problem.AddResidualBlock(finger_separation_cost(tips, opt), nullptr, x, beta->data());
     if (t > 0)
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SmoothCost, kX, kX, kX>(
                                    new SmoothCost{std::sqrt(opt.w_smooth * kJ)}),
@@ -245,7 +269,24 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
                            nullptr, beta->data());
   if (!opt.fit_shape) problem.SetParameterBlockConstant(beta->data());
   ceres::Solver::Summary summary;
+  int separation_steps = 0;  // of the first solve, when a second one holds fingers apart
   solve(&problem, opt.max_iterations, sparse_solver(), &summary);
+  // Fingers apart: the joint solve can close up fingers the warm start kept apart, so the
+  // frames near the gap after it get the term and the solve goes on from there.
+  bool separated = false;
+  for (int64_t t = 0; t < N; ++t) {
+    double* x = states->data() + t * kX;
+    if (!near_gap(x)) continue;
+    problem.AddResidualBlock(finger_separation_cost(rj_sub, rj, opt), nullptr, x, beta->data());
+    separated = true;
+  }
+  if (separated) {
+    const double initial = summary.initial_cost;
+    const int steps = static_cast<int>(summary.iterations.size()) - 1;
+    solve(&problem, opt.max_iterations, sparse_solver(), &summary);
+    summary.initial_cost = initial;
+    separation_steps = steps;
+  }
   // What the penalty leaves outside a range goes onto its edge (core/hand/joint_limits.h).
   if (opt.w_limits > 0)
     for (int64_t t = 0; t < N; ++t) limits.clamp_pose(states->data() + t * kX + 3);
@@ -263,7 +304,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   }
   report->initial_cost = summary.initial_cost;
   report->final_cost = summary.final_cost;
-  report->iterations = static_cast<int>(summary.iterations.size()) - 1;
+  report->iterations = separation_steps + static_cast<int>(summary.iterations.size()) - 1;
   report->mean_keypoint_error = err / static_cast<double>(N * kJ);
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -48,8 +48,9 @@ struct ManoFitOptions {
   double w_fingers = 0;
   double finger_gap = kFingerGap;  // m
   // Fingers apart (core/hand/finger_separation.h): two fingers' bones 1 mm inside the gap
-  // cost as much as all 100 keypoints √w_separation mm off. 0 = off.
-  double w_separation = 0;
+  // cost as much as all 100 keypoints √w_separation mm off (100: 10 mm). 0 = off. On
+  // generated samples Implaus after the fit 5.0 → 0.0 % (docs/refinement.md).
+  double w_separation = 100;
   double separation_gap = kFingerSeparation;  // m
   bool fit_shape = true;   // false: β stays 0
   int warm_start_iterations = 3;  // per frame, sequentially

@@ -18,6 +18,7 @@
 #include "core/geometry/point_guard.h"
 #include "core/hand/finger_separation.h"
 #include "core/hand/joint_limits.h"
+#include "core/hand/regressed_joints.h"
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
 #include "core/hand/lbs_subset.h"
@@ -78,7 +79,8 @@ struct HandData {
   double s_limits = 0;
   std::vector<double> p_start;  // [N × 51] the start's parameters (w_pose), s_pose √(2 w_pose / N) · ℓ_f
   double s_pose = 0;
-  LbsSubset tips;    // the five fingertip vertices (w_separation), residual scale √(2 w_separation / N)
+  RegressedJoints rj;  // the joints as the measure reads them (w_separation), residual scale √(2 w_separation / N)
+  LbsSubset rj_sub;    // rj.vertex_ids
   double s_sep = 0;
   // What Ceres optimises, [N × 51]: x itself, or with RefineOptions::joint_angles x with
   // each finger joint's axis-angle as its three bounded angles (JointLimits::rotation).
@@ -140,25 +142,41 @@ struct FingerSeparationCost {
     const T* fingers[5] = {f0, f1, f2, f3, f4};
     for (int g = 0; g < 5; ++g) std::copy(fingers[g], fingers[g] + 9, p + 3 + 9 * g);
     state_of(*d, p, x);
+    std::vector<T> posed(static_cast<size_t>(3 * d->rj_sub.size()));
+    lbs_subset(d->rj_sub, x, x + 3, x + 48, d->beta.data(), posed.data());
     T tip[5][3], J[HandModel::kNumJoints][3];
-    lbs_subset(d->tips, x, x + 3, x + 48, d->beta.data(), &tip[0][0], &J[0][0]);
+    d->rj.apply(posed.data(), J, tip);
     finger_separation_shortfall<T>(J, tip, gap, r);
     for (int i = 0; i < kFingerSeparationResiduals; ++i) r[i] *= T(scale);
     return true;
   }
 };
 
+// Frame t's separation shortfalls (m, max(0, gap − distance)) at the current x.
+void separation_shortfall(const HandData& d, int64_t t, double gap, double* r) {
+  const double* x = d.x.data() + t * kX;
+  std::vector<double> posed(static_cast<size_t>(3 * d.rj_sub.size()));
+  lbs_subset(d.rj_sub, x, x + 3, x + 48, d.beta.data(), posed.data());
+  double tip[5][3], J[HandModel::kNumJoints][3];
+  d.rj.apply(posed.data(), J, tip);
+  finger_separation_shortfall<double>(J, tip, gap, r);
+}
+
 // Σ_t Σ_pairs max(0, gap − d)² (m²) of the hand's current poses.
 double separation_sum(const HandData& d, double gap) {
-  double sum = 0;
-  double tip[5][3], J[HandModel::kNumJoints][3], r[kFingerSeparationResiduals];
+  double sum = 0, r[kFingerSeparationResiduals];
   for (int64_t t = 0; t < d.N; ++t) {
-    const double* x = d.x.data() + t * kX;
-    lbs_subset(d.tips, x, x + 3, x + 48, d.beta.data(), &tip[0][0], &J[0][0]);
-    finger_separation_shortfall<double>(J, tip, gap, r);
+    separation_shortfall(d, t, gap, r);
     for (double v : r) sum += v * v;
   }
   return sum;
+}
+
+// Whether frame t's fingers come within kSeparationActive of the gap (the term's active set).
+bool near_gap(const HandData& d, int64_t t, double gap) {
+  double r[kFingerSeparationResiduals];
+  separation_shortfall(d, t, gap + kSeparationActive, r);
+  return *std::max_element(r, r + kFingerSeparationResiduals) > 0;
 }
 
 // Σ_t Σ_j ||excess||² (rad²) of the hand's current poses.
@@ -496,6 +514,11 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   Evaluation e;
   double proj = 0, pen = 0, acc = 0, fit = 0, hold = 0, kerr = 0;
   std::vector<Points3> acc_points;
+  // Kept for the penetration planes, built after every frame's way out is known.
+  std::vector<Points3> frame_v(relinearise ? static_cast<size_t>(N) : 0);
+  std::vector<std::vector<std::pair<int, ObjectSurfaceQuery>>> frame_near(frame_v.size());
+  std::vector<double> frame_depths(frame_v.size(), 0.0);
+  std::vector<Eigen::Vector3d> exits(frame_v.size(), Eigen::Vector3d::Zero());
   for (int64_t t = 0; t < N; ++t) {
     const Points3 v = pose_all(all, d->x.data() + t * kX, d->beta.data());
     const ObjectState& st = d->states[static_cast<size_t>(t)];
@@ -541,6 +564,39 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     for (size_t i = 0; i < d->acc_ids.size(); ++i) a.row(static_cast<Eigen::Index>(i)) = v.row(d->acc_ids[i]);
     acc_points.push_back(std::move(a));
     if (!f) continue;
+    frame_v[static_cast<size_t>(t)] = v;
+    frame_near[static_cast<size_t>(t)] = near;
+    double frame_depth = 0;
+    for (const auto& [i, q] : near) frame_depth = std::max(frame_depth, q.signed_distance + clear);
+    frame_depths[static_cast<size_t>(t)] = frame_depth;
+    // A deep frame's inside vertices leave towards the hand's outside (exit_direction),
+    // not each to its nearest surface: in a part thinner than twice their depth the
+    // nearest side flips between vertices and rounds, and the hand stays stuck in it.
+    if (frame_depth > o.pen_exit_depth) exits[static_cast<size_t>(t)] = exit_direction(v, near);
+  }
+  // With pen_exit_smooth k: the way out of each frame within k frames of a deep one (and
+  // with a vertex inside) is the mean of the deep frames' ways out within k frames. Frame by
+  // frame it can point up in one frame and down the next (a hand around a thin part's
+  // edge), and a frame just under pen_exit_depth takes nearest planes beside one just over
+  // it: either way the hand leaves each frame its own way, in jumps.
+  if (relinearise && o.pen_exit_smooth > 0) {
+    const std::vector<Eigen::Vector3d> raw = exits;
+    for (int64_t t = 0; t < N; ++t) {
+      if (frame_depths[static_cast<size_t>(t)] <= 0) continue;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int64_t u = std::max<int64_t>(0, t - o.pen_exit_smooth); u <= std::min(N - 1, t + o.pen_exit_smooth); ++u)
+        sum += raw[static_cast<size_t>(u)];
+      if (sum.norm() > 1e-9) exits[static_cast<size_t>(t)] = sum.normalized();
+    }
+  }
+  for (int64_t t = 0; relinearise && t < N; ++t) {
+    FrameTerms* f = &d->frames[static_cast<size_t>(t)];
+    const Points3& v = frame_v[static_cast<size_t>(t)];
+    const auto& near = frame_near[static_cast<size_t>(t)];
+    const ObjectState& st = d->states[static_cast<size_t>(t)];
+    const double clear = d->clearance[static_cast<size_t>(t)];
+    const double frame_depth = frame_depths[static_cast<size_t>(t)];
+    const Eigen::Vector3d& exit = exits[static_cast<size_t>(t)];
     // The frame's subset: keypoints, acceleration vertices, near vertices (no repeats).
     std::vector<int> ids = d->kp_ids, row_of(static_cast<size_t>(V), -1);
     for (int k = 0; k < kJ; ++k) row_of[static_cast<size_t>(ids[static_cast<size_t>(k)])] = k;
@@ -562,15 +618,9 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     f->pen.clear();
     f->pen_scale.clear();
     f->pen_offset.clear();
-    double frame_depth = 0;
-    for (const auto& [i, q] : near) frame_depth = std::max(frame_depth, q.signed_distance + clear);
     double& boost = d->pen_boost[static_cast<size_t>(t)];
     if (grow && frame_depth > o.pen_tolerance) boost *= o.pen_growth;
     e.max_boost = std::max(e.max_boost, boost);
-    // A deep frame's inside vertices leave towards the hand's outside (exit_direction),
-    // not each to its nearest surface: in a part thinner than twice their depth the
-    // nearest side flips between vertices and rounds, and the hand stays stuck in it.
-    const Eigen::Vector3d exit = frame_depth > o.pen_exit_depth ? exit_direction(v, near) : Eigen::Vector3d::Zero();
     for (const auto& [i, q] : near) {
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
       const bool turn = q.signed_distance > 0 && !exit.isZero() && q.normal.dot(exit) < 0;
@@ -731,7 +781,8 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   d->s_limits = std::sqrt(2 * o.w_limits / static_cast<double>(d->N)) * kLeverFinger;
   d->s_pose = std::sqrt(2 * o.w_pose / static_cast<double>(d->N)) * kLeverFinger;
   d->s_sep = std::sqrt(2 * o.w_separation / static_cast<double>(d->N));
-  d->tips = LbsSubset::from(*d->model, std::vector<int>(d->model->fingertips.begin(), d->model->fingertips.end()));
+  d->rj = RegressedJoints::from(*d->model);
+  d->rj_sub = LbsSubset::from(*d->model, d->rj.vertex_ids);
   d->p_start.resize(d->x.size());
   for (int64_t t = 0; t < d->N; ++t) params_of(*d, d->x.data() + t * kX, d->p_start.data() + t * kX);
   for (int p : d->hold_part) rep->held_frames += p >= 0;
@@ -778,7 +829,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         for (int g = 0; g < 5; ++g)
           problem.AddResidualBlock(new ValuePinCost<9>(d->p_start.data() + t * kX + 3 + 9 * g, d->s_pose), nullptr,
                                    x + 3 + 9 * g);
-      if (o.w_separation > 0 && !d->is_kept(t))
+      if (o.w_separation > 0 && !d->is_kept(t) && near_gap(*d, t, o.separation_gap))
         problem.AddResidualBlock(
             new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, 9, 9, 9, 9, 9>(
                 new FingerSeparationCost{d, o.separation_gap, d->s_sep}),
@@ -969,6 +1020,7 @@ void RefineOptions::validate() const {
   nonneg(separation_gap, "separation_gap");
   nonneg(pen_margin, "pen_margin");
   if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");
+  if (pen_exit_smooth < 0) throw Error("refinement: pen_exit_smooth must be >= 0 (frames)");
   if (outer_iterations < 0) throw Error("refinement: outer_iterations must be >= 0");
   if (max_outer_iterations < 0) throw Error("refinement: max_outer_iterations must be >= 0");
   nonneg(pen_tolerance, "pen_tolerance");

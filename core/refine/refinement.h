@@ -73,6 +73,10 @@ struct RefineOptions {
   // surface faces away from the rest of the hand take the plane where they leave the object
   // towards it (a thin part passed through; 0 = always, 1e9 = never: nearest surface)
   double pen_exit_depth = 0.005;
+  // frames: every frame within this many frames of a deep one (with a vertex inside) leaves
+  // the way the deep frames there leave on average (0 = each deep frame its own way, the
+  // others by their nearest planes)
+  int pen_exit_smooth = 0;
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
   double w_hold = 0;           // the hold term (ours; 0 = off, the paper's)

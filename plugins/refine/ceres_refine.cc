@@ -39,6 +39,8 @@ class CeresRefineStage : public Refiner {
             .param("pen_margin", d.pen_margin, "m: vertices this close to the surface get a penetration plane")
             .param("pen_exit_depth", d.pen_exit_depth,
                    "m: frames deeper than this push inside vertices out towards the rest of the hand (1e9 = off)")
+            .param("pen_exit_smooth", std::int64_t{d.pen_exit_smooth},
+                   "frames: frames this near a deep one leave the way the deep ones there do on average (0: each its own)")
             .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
             .param("pen_growth", d.pen_growth, "factor of that growth per round")
             .param("accel_vertices", d.accel_vertices, "hand vertices in the acceleration term (>= 32)")
@@ -77,6 +79,7 @@ class CeresRefineStage : public Refiner {
     o_.max_outer_iterations = static_cast<int>(p.integer("max_rounds"));
     o_.pen_margin = p.number("pen_margin");
     o_.pen_exit_depth = p.number("pen_exit_depth");
+    o_.pen_exit_smooth = static_cast<int>(p.integer("pen_exit_smooth"));
     o_.pen_tolerance = p.number("pen_tolerance");
     o_.pen_growth = p.number("pen_growth");
     o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));

@@ -132,7 +132,7 @@ TEST(FingerSeparation, ShortfallIsZeroForAGraspAndPositiveForCrossedFingers) {
       const Posed p = pose(h, fingers);
       double J[16][3], tips[5][3], r[kFingerSeparationResiduals];
       for (int j = 0; j < 16; ++j)
-        for (int k = 0; k < 3; ++k) J[j][k] = p.r.joints(j, k);
+        for (int k = 0; k < 3; ++k) J[j][k] = p.joints(j, k);  // regressed, as the measure
       for (int f = 0; f < 5; ++f)
         for (int k = 0; k < 3; ++k) tips[f][k] = p.tips(f, k);
       finger_separation_shortfall<double>(J, tips, kFingerSeparation, r);

@@ -76,16 +76,18 @@ inline double largest_joint_excess(const std::array<const HandModel*, 2>& models
 
 // The closest two fingers' bones come over all frames and hands (m).
 inline double closest_fingers(const std::array<const HandModel*, 2>& models, const HandMotion& m) {
-  const PosedHands p = pose_hands(models, m);
-  const at::Tensor J = p.joints.to(at::kDouble).contiguous(), V = p.vertices.to(at::kDouble).contiguous();
+  const at::Tensor V = pose_hands(models, m).vertices.to(at::kDouble).contiguous();
   double closest = 1;
   for (int h = 0; h < 2; ++h)
-    for (int64_t t = 0; t < J.size(1); ++t) {
+    for (int64_t t = 0; t < V.size(1); ++t) {
+      const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> x(
+          V[h][t].data_ptr<double>(), V.size(2), 3);
+      const Eigen::Matrix<double, 16, 3> Jr = models[h]->j_regressor * x;  // as the measure reads them
       double joints[16][3], tips[5][3], r[kFingerSeparationResiduals];
       for (int j = 0; j < 16; ++j)
-        for (int k = 0; k < 3; ++k) joints[j][k] = J[h][t][j][k].item<double>();
+        for (int k = 0; k < 3; ++k) joints[j][k] = Jr(j, k);
       for (int f = 0; f < 5; ++f)
-        for (int k = 0; k < 3; ++k) tips[f][k] = V[h][t][models[h]->fingertips[f]][k].item<double>();
+        for (int k = 0; k < 3; ++k) tips[f][k] = x(models[h]->fingertips[f], k);
       finger_separation_shortfall<double>(joints, tips, 1.0, r);  // gap 1 m: 1 − distance
       for (double v : r) closest = std::min(closest, 1.0 - v);
     }

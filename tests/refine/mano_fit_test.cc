@@ -126,9 +126,10 @@ TEST(ManoFit, KeepsTwoFingersApartOnMergedKeypoints) {
   const HandMotion truth = test::known_motion(models, N, /*seed=*/7);
   EXPECT_GT(test::closest_fingers(models, truth), kCrossedGap) << "the known motion is plausible";
   const at::Tensor H = test::merged_keypoints(models, truth, 0.012);
-  const double merged = test::closest_fingers(models, fit_mano(models, H.to(at::kFloat), ManoFitOptions{}));
-  ManoFitOptions on;
-  on.w_separation = 100;
+  ManoFitOptions off;
+  off.w_separation = 0;
+  const double merged = test::closest_fingers(models, fit_mano(models, H.to(at::kFloat), off));
+  const ManoFitOptions on;  // the default holds them apart
   const double apart = test::closest_fingers(models, fit_mano(models, H.to(at::kFloat), on));
   std::printf("closest fingers: %.1f mm without the term, %.1f mm with it\n", merged * 1000, apart * 1000);
   EXPECT_LT(merged, kCrossedGap);

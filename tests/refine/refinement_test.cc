@@ -295,7 +295,9 @@ TEST(Refinement, SeparationPullsMergedFingersApart) {
   truth.vertices = pose_hand_vertices(models, truth);
   const at::Tensor states = at::zeros({N, 7}, at::kFloat);
   const at::Tensor H = test::merged_keypoints(models, truth, 0.012);
-  const HandMotion start = fit_mano(models, H);
+  ManoFitOptions merged;
+  merged.w_separation = 0;  // a start with the fingers merged
+  const HandMotion start = fit_mano(models, H, merged);
   const at::Tensor X = keypoint_features(H, object, states);
   RefineOptions off, on;
   off.w_pose = on.w_pose = 1e4;
