@@ -190,8 +190,20 @@ TEST(Refinement, AHandSunkPastTheMiddleOfAThinPartLeavesOnItsOwnSide) {
     // Out on top, where the hand came from, not through the underside.
     EXPECT_GT(out.vertices[h].select(2, 2).mean().item<double>(), 0.0) << "hand " << h;
   }
+  // Every frame's way out averaged with its neighbours' (pen_exit_smooth): the same way here,
+  // so the same result.
+  RefineOptions smoothed = exit;
+  smoothed.pen_exit_smooth = 2;
+  RefineReport s;
+  const HandMotion out_s = refine_hands(models, distance, c.states, c.pushed, c.fit, smoothed, &s);
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_LE(s.hands[h].max_depth_after, exit.pen_tolerance) << "hand " << h;
+    EXPECT_GT(out_s.vertices[h].select(2, 2).mean().item<double>(), 0.0) << "hand " << h;
+  }
   nearest.pen_exit_depth = -1;
   EXPECT_THROW(nearest.validate(), Error);
+  smoothed.pen_exit_smooth = -1;
+  EXPECT_THROW(smoothed.validate(), Error);
 }
 
 // The hold term: hands predicted 3 cm above the slab (no projection term, which would also
