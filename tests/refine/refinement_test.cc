@@ -72,6 +72,14 @@ HandMotion hands_on_the_slab(const std::array<const HandModel*, 2>& models, int 
 
 std::vector<int> ids_of(const HandModel& m) { return model_keypoints(m); }
 
+// A known motion (tests/refine/known_motion.h) lifted `height` (m): far from the slab.
+HandMotion above_the_slab(const std::array<const HandModel*, 2>& models, int N, unsigned seed, float height) {
+  HandMotion m = test::known_motion(models, N, seed);
+  for (auto& p : m.hands) p.trans = p.trans + at::tensor({0.0f, 0.0f, height});
+  m.vertices = pose_hand_vertices(models, m);
+  return m;
+}
+
 // Hands on the slab (the truth) and a prediction of them `depth` (m) too deep: keypoints
 // sunk, directions to the surface as they were; with its MANO fit.
 struct PushedHands {
@@ -245,9 +253,7 @@ TEST(Refinement, AJitterySequenceComesOutSmoother) {
   const ObjectDistance distance(object);
   const int N = 20;
   // Hands well above the slab: only the acceleration and fit terms act.
-  HandMotion truth = test::known_motion(models, N, 21);
-  for (auto& p : truth.hands) p.trans = p.trans + at::tensor({0.0f, 0.0f, 0.5f});
-  truth.vertices = pose_hand_vertices(models, truth);
+  const HandMotion truth = above_the_slab(models, N, 21, 0.5f);
   const at::Tensor states = at::zeros({N, 7}, at::kFloat);
   at::Tensor H = test::noisy_keypoints(models, truth, 1.0, 22);
   at::Generator gen = at::detail::createCPUGenerator(23);
@@ -302,9 +308,7 @@ TEST(Refinement, SeparationPullsMergedFingersApart) {
   const ArticulatedObject object = slab();
   const ObjectDistance distance(object);
   const int N = 6;
-  HandMotion truth = test::known_motion(models, N, 7);
-  for (auto& p : truth.hands) p.trans = p.trans + at::tensor({0.0f, 0.0f, 0.3f});  // far above the slab
-  truth.vertices = pose_hand_vertices(models, truth);
+  const HandMotion truth = above_the_slab(models, N, 7, 0.3f);
   const at::Tensor states = at::zeros({N, 7}, at::kFloat);
   const at::Tensor H = test::merged_keypoints(models, truth, 0.012);
   ManoFitOptions merged;
