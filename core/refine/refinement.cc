@@ -35,6 +35,7 @@ namespace {
 constexpr int kJ = 100;
 constexpr int kX = kHandStateSize;
 constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
+constexpr double kClearanceTolerance = 0.0005;  // m
 using Jet = ceres::Jet<double, kX>;
 
 struct Plane {
@@ -623,7 +624,10 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     f->pen_scale.clear();
     f->pen_offset.clear();
     double& boost = d->pen_boost[static_cast<size_t>(t)];
-    if (grow && frame_depth > o.pen_tolerance) boost *= o.pen_growth;
+    // A clearance is a promise to the animator (`bimart constraints` allows it 1 mm): its
+    // frames grow their weight from kClearanceTolerance on, not from pen_tolerance.
+    const double tolerance = clear > 0 ? std::min(o.pen_tolerance, kClearanceTolerance) : o.pen_tolerance;
+    if (grow && frame_depth > tolerance) boost *= o.pen_growth;
     e.max_boost = std::max(e.max_boost, boost);
     for (const auto& [i, q] : near) {
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
