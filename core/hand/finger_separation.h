@@ -77,4 +77,13 @@ void finger_separation_shortfall(const T (*joints)[3], const T (*tips)[3], doubl
         }
 }
 
+// The distance the closest two bones of two different fingers come (m); joints and tips as above.
+inline double closest_fingers(const double (*joints)[3], const double (*tips)[3]) {
+  double r[kFingerSeparationResiduals];
+  finger_separation_shortfall<double>(joints, tips, 1.0, r);  // gap 1 m: 1 − distance
+  double worst = r[0];
+  for (double v : r) worst = v > worst ? v : worst;
+  return 1.0 - worst;
+}
+
 }  // namespace bimart

@@ -18,6 +18,7 @@ RegressedJoints RegressedJoints::from(const HandModel& m) {
       if (w != 0.0) r.rows[static_cast<size_t>(j)].emplace_back(add(v), w);
     }
   for (int f = 0; f < 5; ++f) r.tips[static_cast<size_t>(f)] = add(m.fingertips[static_cast<size_t>(f)]);
+  r.sub = LbsSubset::from(m, r.vertex_ids);
   return r;
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/hand/hand_model.h"
+#include "core/hand/lbs_subset.h"
 
 namespace bimart {
 
@@ -19,7 +20,17 @@ struct RegressedJoints {
   std::vector<int> vertex_ids;  // the vertices to pose: the regressor's support for joints 1-15, then the 5 fingertips
   std::array<std::vector<std::pair<int, double>>, HandModel::kNumJoints> rows;  // per joint: (index into vertex_ids, weight); joint 0 empty
   std::array<int, 5> tips{};  // index into vertex_ids of each fingertip (thumb, index, middle, ring, pinky)
+  LbsSubset sub;              // vertex_ids, to pose
   static RegressedJoints from(const HandModel& model);
+
+  // The joints and tips of frame state x (rot 3, pose 45, trans 3) with shape beta: the
+  // vertices posed (lbs_subset), then apply(); any scalar types (Ceres Jets).
+  template <class T, class TB>
+  void pose(const T* x, const TB* beta, T (*joints)[3], T (*tip)[3]) const {
+    std::vector<T> posed(static_cast<size_t>(3 * sub.size()));
+    lbs_subset(sub, x, x + 3, x + 48, beta, posed.data());
+    apply(posed.data(), joints, tip);
+  }
 
   // posed [3 × vertex_ids.size()] (x, y, z per vertex) → joints [16][3] (row 0, the wrist,
   // left zero) and tips [5][3]; any scalar type (Ceres Jets).

@@ -14,9 +14,6 @@
 namespace bimart {
 namespace {
 
-// m: cavity depths up to this read 0 (only Cavity's 1 cm threshold reads them).
-constexpr double kCavityFloor = 0.005;
-
 // Diverged motion (NaN, or absurdly far) is reported with its frame, hand and vertex
 // before any of it reaches CGAL.
 void check_frame_points(const Points3& pts, int64_t v, int64_t t) {

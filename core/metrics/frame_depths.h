@@ -10,6 +10,9 @@
 
 namespace bimart {
 
+// m: cavity depths up to this read 0 (only Cavity's 1 cm threshold reads them).
+constexpr double kCavityFloor = 0.005;
+
 struct FrameDepths {
   // max over both hands' vertices of the signed distance (m, > 0 inside) to each part.
   std::vector<double> top, bottom;

@@ -4,16 +4,13 @@
 
 #include <ATen/ATen.h>
 
-#include <algorithm>
-
 #include "core/hand/finger_separation.h"
+#include "core/metrics/frame_depths.h"
 #include "core/metrics/hand_plausibility.h"
 #include "core/util/error.h"
 
 namespace bimart {
 namespace {
-
-constexpr double kCavityFloor = 0.005;  // m, as the Cavity column (core/metrics/frame_depths.cc)
 
 int skinning_joint(const HandModel& m, int vertex) {
   Eigen::Index j = 0;
@@ -63,13 +60,12 @@ std::vector<HandFrameRow> hand_frame_rows(const ObjectDistance& distance, const 
       Eigen::Matrix<double, 5, 3> tips;
       for (int f = 0; f < 5; ++f) tips.row(f) = pts.row(m.fingertips[static_cast<size_t>(f)]);
       r.implausible = implausibility(J, tips, h);
-      double j3[16][3], t3[5][3], shortfall[kFingerSeparationResiduals];
+      double j3[16][3], t3[5][3];
       for (int j = 0; j < 16; ++j)
         for (int k = 0; k < 3; ++k) j3[j][k] = J(j, k);
       for (int f = 0; f < 5; ++f)
         for (int k = 0; k < 3; ++k) t3[f][k] = tips(f, k);
-      finger_separation_shortfall<double>(j3, t3, 1.0, shortfall);  // gap 1 m: 1 − distance
-      r.closest_fingers = 1.0 - *std::max_element(shortfall, shortfall + kFingerSeparationResiduals);
+      r.closest_fingers = closest_fingers(j3, t3);
       rows.push_back(std::move(r));
     }
   }

@@ -98,15 +98,12 @@ ceres::CostFunction* finger_order_cost(const LbsSubset& tips, const ManoFitOptio
 // Fingers apart (core/hand/finger_separation.h): scale · max(0, gap − distance), 90 per
 // frame, between bones through the joints the measure regresses from the vertices.
 struct FingerSeparationCost {
-  const LbsSubset* sub;  // RegressedJoints::vertex_ids
   const RegressedJoints* rj;
   double gap, scale;
   template <class T>
   bool operator()(const T* x, const T* beta, T* r) const {
-    std::vector<T> posed(static_cast<size_t>(3 * sub->size()));
-    lbs_subset(*sub, x, x + 3, x + 48, beta, posed.data());
     T tip[5][3], J[HandModel::kNumJoints][3];
-    rj->apply(posed.data(), J, tip);
+    rj->pose(x, beta, J, tip);
     finger_separation_shortfall<T>(J, tip, gap, r);
     for (int i = 0; i < kFingerSeparationResiduals; ++i) r[i] *= T(scale);
     return true;
@@ -114,18 +111,15 @@ struct FingerSeparationCost {
 };
 
 // The closest two fingers' bones come in frame state x (m).
-double closest_fingers(const LbsSubset& sub, const RegressedJoints& rj, const double* x, const double* beta) {
-  std::vector<double> posed(static_cast<size_t>(3 * sub.size()));
-  lbs_subset(sub, x, x + 3, x + 48, beta, posed.data());
-  double tip[5][3], J[HandModel::kNumJoints][3], r[kFingerSeparationResiduals];
-  rj.apply(posed.data(), J, tip);
-  finger_separation_shortfall<double>(J, tip, 1.0, r);  // gap 1 m: 1 − distance
-  return 1.0 - *std::max_element(r, r + kFingerSeparationResiduals);
+double closest_fingers(const RegressedJoints& rj, const double* x, const double* beta) {
+  double tip[5][3], J[HandModel::kNumJoints][3];
+  rj.pose(x, beta, J, tip);
+  return bimart::closest_fingers(J, tip);
 }
 
-ceres::CostFunction* finger_separation_cost(const LbsSubset& sub, const RegressedJoints& rj, const ManoFitOptions& opt) {
+ceres::CostFunction* finger_separation_cost(const RegressedJoints& rj, const ManoFitOptions& opt) {
   return new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, kX, kB>(
-      new FingerSeparationCost{&sub, &rj, opt.separation_gap, std::sqrt(opt.w_separation * kJ)});
+      new FingerSeparationCost{&rj, opt.separation_gap, std::sqrt(opt.w_separation * kJ)});
 }
 
 ceres::CostFunction* joint_limit_cost(const JointLimits& limits, double w_limits) {
@@ -206,10 +200,9 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   const JointLimits limits(model);
   const LbsSubset tips = LbsSubset::from(model, std::vector<int>(model.fingertips.begin(), model.fingertips.end()));
   const RegressedJoints rj = RegressedJoints::from(model);
-  const LbsSubset rj_sub = LbsSubset::from(model, rj.vertex_ids);
   // A frame whose fingers come near the gap carries the separation term (kSeparationActive).
   const auto near_gap = [&](const double* x) {
-    return opt.w_separation > 0 && closest_fingers(rj_sub, rj, x, beta->data()) < opt.separation_gap + kSeparationActive;
+    return opt.w_separation > 0 && closest_fingers(rj, x, beta->data()) < opt.separation_gap + kSeparationActive;
   };
 
   auto palm_points = [&](const double* v300) {
@@ -243,7 +236,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
       ceres::Solver::Summary s;
       solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
       if (near_gap(x)) {  // again, with the fingers held apart
-        p.AddResidualBlock(finger_separation_cost(rj_sub, rj, opt), nullptr, x, beta->data());
+        p.AddResidualBlock(finger_separation_cost(rj, opt), nullptr, x, beta->data());
         solve(&p, opt.warm_start_iterations, ceres::DENSE_NORMAL_CHOLESKY, &s);
       }
     }
@@ -277,7 +270,7 @@ void fit_hand(const HandModel& model, const std::vector<double>& targets, int64_
   for (int64_t t = 0; t < N; ++t) {
     double* x = states->data() + t * kX;
     if (!near_gap(x)) continue;
-    problem.AddResidualBlock(finger_separation_cost(rj_sub, rj, opt), nullptr, x, beta->data());
+    problem.AddResidualBlock(finger_separation_cost(rj, opt), nullptr, x, beta->data());
     separated = true;
   }
   if (separated) {

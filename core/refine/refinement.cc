@@ -82,7 +82,6 @@ struct HandData {
   std::vector<double> p_start;  // [N × 51] the start's parameters (w_pose), s_pose √(2 w_pose / N) · ℓ_f
   double s_pose = 0;
   RegressedJoints rj;  // the joints as the measure reads them (w_separation), residual scale √(2 w_separation / N)
-  LbsSubset rj_sub;    // rj.vertex_ids
   double s_sep = 0;
   // What Ceres optimises, [N × 51]: x itself, or with RefineOptions::joint_angles x with
   // each finger joint's axis-angle as its three bounded angles (JointLimits::rotation).
@@ -144,10 +143,8 @@ struct FingerSeparationCost {
     const T* fingers[5] = {f0, f1, f2, f3, f4};
     for (int g = 0; g < 5; ++g) std::copy(fingers[g], fingers[g] + 9, p + 3 + 9 * g);
     state_of(*d, p, x);
-    std::vector<T> posed(static_cast<size_t>(3 * d->rj_sub.size()));
-    lbs_subset(d->rj_sub, x, x + 3, x + 48, d->beta.data(), posed.data());
     T tip[5][3], J[HandModel::kNumJoints][3];
-    d->rj.apply(posed.data(), J, tip);
+    d->rj.pose(x, d->beta.data(), J, tip);
     finger_separation_shortfall<T>(J, tip, gap, r);
     for (int i = 0; i < kFingerSeparationResiduals; ++i) r[i] *= T(scale);
     return true;
@@ -156,11 +153,8 @@ struct FingerSeparationCost {
 
 // Frame t's separation shortfalls (m, max(0, gap − distance)) at the current x.
 void separation_shortfall(const HandData& d, int64_t t, double gap, double* r) {
-  const double* x = d.x.data() + t * kX;
-  std::vector<double> posed(static_cast<size_t>(3 * d.rj_sub.size()));
-  lbs_subset(d.rj_sub, x, x + 3, x + 48, d.beta.data(), posed.data());
   double tip[5][3], J[HandModel::kNumJoints][3];
-  d.rj.apply(posed.data(), J, tip);
+  d.rj.pose(d.x.data() + t * kX, d.beta.data(), J, tip);
   finger_separation_shortfall<double>(J, tip, gap, r);
 }
 
@@ -791,7 +785,6 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   d->s_pose = std::sqrt(2 * o.w_pose / static_cast<double>(d->N)) * kLeverFinger;
   d->s_sep = std::sqrt(2 * o.w_separation / static_cast<double>(d->N));
   d->rj = RegressedJoints::from(*d->model);
-  d->rj_sub = LbsSubset::from(*d->model, d->rj.vertex_ids);
   d->p_start.resize(d->x.size());
   for (int64_t t = 0; t < d->N; ++t) params_of(*d, d->x.data() + t * kX, d->p_start.data() + t * kX);
   for (int p : d->hold_part) rep->held_frames += p >= 0;

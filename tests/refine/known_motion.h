@@ -83,13 +83,12 @@ inline double closest_fingers(const std::array<const HandModel*, 2>& models, con
       const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> x(
           V[h][t].data_ptr<double>(), V.size(2), 3);
       const Eigen::Matrix<double, 16, 3> Jr = models[h]->j_regressor * x;  // as the measure reads them
-      double joints[16][3], tips[5][3], r[kFingerSeparationResiduals];
+      double joints[16][3], tips[5][3];
       for (int j = 0; j < 16; ++j)
         for (int k = 0; k < 3; ++k) joints[j][k] = Jr(j, k);
       for (int f = 0; f < 5; ++f)
         for (int k = 0; k < 3; ++k) tips[f][k] = x(models[h]->fingertips[f], k);
-      finger_separation_shortfall<double>(joints, tips, 1.0, r);  // gap 1 m: 1 − distance
-      for (double v : r) closest = std::min(closest, 1.0 - v);
+      closest = std::min(closest, bimart::closest_fingers(joints, tips));
     }
   return closest;
 }
