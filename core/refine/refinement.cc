@@ -23,6 +23,7 @@
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
 #include "core/hand/lbs_subset.h"
+#include "core/refine/exit_plane.h"
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
 #include "core/util/error.h"
@@ -37,11 +38,6 @@ constexpr int kX = kHandStateSize;
 constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
 constexpr double kClearanceTolerance = 0.0005;  // m
 using Jet = ceres::Jet<double, kX>;
-
-struct Plane {
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // on the surface
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, outward
-};
 
 // One frame's linearisation: the vertices posed (keypoints first, then the acceleration
 // vertices, then those near the object) and the tangent planes.
@@ -458,42 +454,6 @@ Points3 pose_all(const LbsSubset& all, const double* x, const double* beta) {
 
 Plane plane_of(const ObjectSurfaceQuery& q) { return Plane{q.closest, q.normal}; }
 
-// The direction from a frame's inside vertices to the rest of the hand (zero when the hand
-// is wholly inside or not inside at all): where the hand as a whole is, it can leave.
-Eigen::Vector3d exit_direction(const Points3& v, const std::vector<std::pair<int, ObjectSurfaceQuery>>& near) {
-  Eigen::Vector3d sum_in = Eigen::Vector3d::Zero();
-  int n_in = 0;
-  for (const auto& [i, q] : near)
-    if (q.signed_distance > 0) sum_in += v.row(i).transpose(), ++n_in;
-  const int n_out = static_cast<int>(v.rows()) - n_in;
-  if (n_in == 0 || n_out == 0) return Eigen::Vector3d::Zero();
-  const Eigen::Vector3d sum_out = v.colwise().sum().transpose() - sum_in;  // the rest of the hand
-  const Eigen::Vector3d e = sum_out / n_out - sum_in / n_in;
-  return e.norm() > 1e-9 ? Eigen::Vector3d(e.normalized()) : Eigen::Vector3d::Zero();
-}
-
-// The plane where a ray from inside point p along unit e leaves the object: sphere tracing
-// (a step of the signed distance never crosses the surface), then the surface there; its
-// normal is turned to face along e. None when the ray stays inside for kReach: a ray along
-// a thin part's plane can run inside it for its whole length, and a plane where the ray
-// gave up pushed hands 6 cm off (keypoint errors of 50–200 mm on generated samples).
-std::optional<Plane> exit_plane(const ObjectDistance& dist, const ObjectState& st, Eigen::Vector3d p,
-                                const Eigen::Vector3d& e) {
-  constexpr double kReach = 0.06, kClose = 2e-4;  // m
-  double travelled = 0;
-  for (int step = 0; step < 32 && travelled < kReach; ++step) {
-    const ObjectSurfaceQuery q = dist.query(st, p);
-    if (q.signed_distance < kClose) {
-      const Eigen::Vector3d n = q.normal.dot(e) > 0 ? q.normal : e;
-      return Plane{q.closest, n};
-    }
-    const double stride = std::max(q.signed_distance, kClose);
-    p += stride * e;
-    travelled += stride;
-  }
-  return std::nullopt;
-}
-
 struct Evaluation {
   RefineTerms terms;
   double max_depth = 0;
@@ -822,10 +782,11 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         const std::vector<Block> blocks = blocks_of(masks[static_cast<size_t>(d->kp_ids[static_cast<size_t>(f.hold_k)])]);
         problem.AddResidualBlock(new HoldCost(d, t, blocks), nullptr, block_pointers(x, blocks));
       }
+      const double grown = o.grow_constraints ? d->pen_boost[static_cast<size_t>(t)] : 1.0;
       if (o.w_limits > 0)  // with bounded angles, only the thumb's box corners can be outside
         for (int g = d->angles ? 4 : 0; g < 5; ++g)
           problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FingerLimitCost, 9, 9>(
-                                       new FingerLimitCost{&*d->limits, g, d->s_limits, d->angles}),
+                                       new FingerLimitCost{&*d->limits, g, d->s_limits * grown, d->angles}),
                                    nullptr, x + 3 + 9 * g);
       if (o.w_pose > 0 && !d->is_kept(t))
         for (int g = 0; g < 5; ++g)
@@ -834,7 +795,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
       if (o.w_separation > 0 && !d->is_kept(t) && near_gap(*d, t, o.separation_gap))
         problem.AddResidualBlock(
             new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, 9, 9, 9, 9, 9>(
-                new FingerSeparationCost{d, o.separation_gap, d->s_sep}),
+                new FingerSeparationCost{d, o.separation_gap, d->s_sep * grown}),
             nullptr, x + 3, x + 12, x + 21, x + 30, x + 39);
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {

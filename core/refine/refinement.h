@@ -100,6 +100,11 @@ struct RefineOptions {
   // each other.
   double w_separation = 0;
   double separation_gap = 0.010;  // m (kFingerSeparation)
+  // The hand's other constraints grow with penetration (ours; false: the paper's, the
+  // library default): a frame's separation and joint-limit residuals are scaled by its
+  // penetration boost like its penetration rows, so a frame pushed hard out of the object
+  // does not buy it with fingers inside each other or past their ranges.
+  bool grow_constraints = false;
   // Finger joints as bounded angles (ours, off by default): each joint's flexion, abduction
   // and twist (JointLimits::rotation) are the solver's parameters, bounded by their
   // anatomical ranges, so every step stays inside them (the thumb's box corners, outside its

@@ -56,6 +56,8 @@ class CeresRefineStage : public Refiner {
             .param("w_separation", d.w_separation,
                    "fingers apart: two fingers' bones at least separation_gap apart (ours; 0 = off, the paper's)")
             .param("separation_gap", d.separation_gap, "m, the least distance between two fingers' bone axes")
+            .param("grow_constraints", d.grow_constraints,
+                   "a frame's separation and joint-limit terms grow with its penetration weight (ours; false: fixed)")
             .param("joint_angles", d.joint_angles,
                    "finger joints as angles bounded by their anatomical ranges (ours; false: axis-angles, the paper's)")
             .param("backtrack", d.backtrack,
@@ -89,6 +91,7 @@ class CeresRefineStage : public Refiner {
     o_.w_pose = p.number("w_pose");
     o_.w_separation = p.number("w_separation");
     o_.separation_gap = p.number("separation_gap");
+    o_.grow_constraints = p.boolean("grow_constraints");
     o_.joint_angles = p.boolean("joint_angles");
     o_.backtrack = p.boolean("backtrack");
     o_.validate();
