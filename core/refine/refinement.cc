@@ -37,6 +37,7 @@ constexpr int kJ = 100;
 constexpr int kX = kHandStateSize;
 constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
 constexpr double kClearanceTolerance = 0.0005;  // m
+constexpr int kSeparationPasses = 2;  // re-solves per round for frames that came near the gap
 using Jet = ceres::Jet<double, kX>;
 
 // One frame's linearisation: the vertices posed (keypoints first, then the acceleration
@@ -761,6 +762,15 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     ceres::Problem::Options po;
     po.evaluation_callback = &cache;
     ceres::Problem problem(po);
+    std::vector<bool> separated(static_cast<size_t>(d->N), false);  // frames with the separation term
+    const auto add_separation = [&](int64_t t, double grown) {
+      double* x = d->p.data() + t * kX;
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, 9, 9, 9, 9, 9>(
+              new FingerSeparationCost{d, o.separation_gap, d->s_sep * grown}),
+          nullptr, x + 3, x + 12, x + 21, x + 30, x + 39);
+      separated[static_cast<size_t>(t)] = true;
+    };
     // Acceleration rows by finger mask (the same in every frame).
     std::map<unsigned, std::vector<int>> acc_groups;
     for (size_t a = 0; a < d->acc_ids.size(); ++a)
@@ -792,11 +802,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         for (int g = 0; g < 5; ++g)
           problem.AddResidualBlock(new ValuePinCost<9>(d->p_start.data() + t * kX + 3 + 9 * g, d->s_pose), nullptr,
                                    x + 3 + 9 * g);
-      if (o.w_separation > 0 && !d->is_kept(t) && near_gap(*d, t, o.separation_gap))
-        problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<FingerSeparationCost, kFingerSeparationResiduals, 9, 9, 9, 9, 9>(
-                new FingerSeparationCost{d, o.separation_gap, d->s_sep * grown}),
-            nullptr, x + 3, x + 12, x + 21, x + 30, x + 39);
+      if (o.w_separation > 0 && !d->is_kept(t) && near_gap(*d, t, o.separation_gap)) add_separation(t, grown);
       if (t < 2 || o.w_acc == 0) continue;
       for (const auto& [mask, rows] : acc_groups) {
         const std::vector<Block> blocks = blocks_of(mask);
@@ -869,9 +875,28 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     so.function_tolerance = 1e-8;
     ceres::Solver::Summary summary;
     const std::vector<double> p_before = d->p;
-    ceres::Solve(so, &problem, &summary);
-    for (int64_t t = 0; t < d->N; ++t)  // the state at the solution (the cache may hold a rejected step's)
-      if (!d->is_kept(t)) state_of(*d, d->p.data() + t * kX, d->x.data() + t * kX);
+    const auto solve = [&] {
+      ceres::Solve(so, &problem, &summary);
+      rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
+      for (int64_t t = 0; t < d->N; ++t)  // the state at the solution (the cache may hold a rejected step's)
+        if (!d->is_kept(t)) state_of(*d, d->p.data() + t * kX, d->x.data() + t * kX);
+    };
+    solve();
+    // The separation term's active set grows within the round: a frame whose fingers the
+    // solve brought inside the gap from further than kSeparationActive (pushed out of the
+    // object sideways into each other) gets the term and the round's solve goes on. Without
+    // it, such fingers ended the last round crossed (most of Implaus after the refinement).
+    for (int pass = 0; pass < kSeparationPasses && o.w_separation > 0; ++pass) {
+      int added = 0;
+      for (int64_t t = 0; t < d->N; ++t)
+        if (!separated[static_cast<size_t>(t)] && !d->is_kept(t) && near_gap(*d, t, o.separation_gap - kSeparationActive)) {
+          add_separation(t, o.grow_constraints ? d->pen_boost[static_cast<size_t>(t)] : 1.0);
+          ++added;
+        }
+      if (added == 0) break;
+      rep->separation_frames_added += added;
+      solve();
+    }
     if (o.backtrack) rep->backtracked_frames += backtrack(d, all, dist, o, p_before);
     size_t rows = 0, pens = 0;
     for (const FrameTerms& f : d->frames) {
@@ -884,7 +909,6 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
     if (o.w_limits > 0 || d->angles)
       for (int64_t t = 0; t < d->N; ++t)
         if (!d->is_kept(t) && !pinned_fingers.count(t)) rep->clamped_joints += d->limits->clamp_pose(d->x.data() + t * kX + 3);
-    rep->iterations += static_cast<int>(summary.iterations.size()) - 1;
     ++rep->outer_iterations;
     e = timed_evaluate(true, true);
     log::debug("refinement round {} (largest penetration boost {:g}): {} vertices and {} penetration planes per frame; deepest {:.1f} mm "
@@ -1044,10 +1068,10 @@ std::string format_refine_report(const RefineReport& r) {
     const RefineHandReport& x = r.hands[static_cast<size_t>(h)];
     out += fmt::format(
         "{} hand: proj {:.3g} -> {:.3g}, pen {:.3g} -> {:.3g}, acc {:.3g} -> {:.3g}, fit {:.3g} -> {:.3g}, "
-        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped), pose {:.3g}, separation {:.3g} -> {:.3g}; {} steps cut back; "
+        "hold {:.3g} -> {:.3g} ({} frames), limits {:.3g} -> {:.3g} ({} joints clamped), pose {:.3g}, separation {:.3g} -> {:.3g} ({} frames added in rounds); {} steps cut back; "
         "deepest {:.1f} -> {:.1f} mm (penetration boost up to {:.3g}); keypoint error {:.1f} mm; {} steps in {} rounds, {:.2f} s ({:.2f} s surface)\n",
         h == 0 ? "left" : "right", x.before.proj, x.after.proj, x.before.pen, x.after.pen, x.before.acc,
-        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.after.pose, x.before.separation, x.after.separation, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
+        x.after.acc, x.before.fit, x.after.fit, x.before.hold, x.after.hold, x.held_frames, x.before.limits, x.after.limits, x.clamped_joints, x.after.pose, x.before.separation, x.after.separation, x.separation_frames_added, x.backtracked_frames, x.max_depth_before * 1e3, x.max_depth_after * 1e3,
         x.max_pen_boost, x.keypoint_error_after * 1e3, x.iterations, x.outer_iterations, x.seconds, x.surface_seconds);
   }
   return out;

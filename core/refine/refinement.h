@@ -168,6 +168,7 @@ struct RefineHandReport {
   int held_frames = 0;                               // frames this hand was held in
   int clamped_joints = 0;                            // joints put back into their ranges, all rounds
   int backtracked_frames = 0;                        // frames whose step was cut back, all rounds
+  int separation_frames_added = 0;                   // frames given the separation term within a round
   double seconds = 0;
   double surface_seconds = 0;  // of which: surface queries and linearisation
 };
