@@ -62,19 +62,32 @@ ObjectDistance::ObjectDistance(const ArticulatedObject& object)
     : top_(object.top), bottom_(object.bottom), top_hull_(hull_planes(object.top)),
       bottom_hull_(hull_planes(object.bottom)) {}
 
-double ObjectDistance::max_cavity_depth(const ObjectState& state, const Points3& points_world, double floor) const {
+double ObjectDistance::cavity_depth(const ObjectState& state, const Eigen::Vector3d& p, double stop) const {
   const PartFrames f = part_frames(state);
+  const Eigen::Vector3d p_top = f.world_to_top * p, p_bottom = f.world_to_bottom * p;
+  const double inside_hull = std::max(depth_inside(top_hull_, p_top, stop), depth_inside(bottom_hull_, p_bottom, stop));
+  if (inside_hull <= stop) return 0.0;
+  const double sd = std::max(top_.signed_distance(p_top), bottom_.signed_distance(p_bottom));
+  if (sd >= 0) return 0.0;  // inside the object: penetration, not a cavity
+  return std::min(inside_hull, -sd);
+}
+
+double ObjectDistance::max_cavity_depth(const ObjectState& state, const Points3& points_world, double floor) const {
   double best = std::max(floor, 0.0);
+  for (Eigen::Index i = 0; i < points_world.rows(); ++i)
+    best = std::max(best, cavity_depth(state, points_world.row(i).transpose(), best));
+  return best > floor ? best : 0.0;
+}
+
+std::vector<std::pair<int, ObjectSurfaceQuery>> ObjectDistance::cavity_points(const ObjectState& state,
+                                                                              const Points3& points_world,
+                                                                              double floor) const {
+  std::vector<std::pair<int, ObjectSurfaceQuery>> out;
   for (Eigen::Index i = 0; i < points_world.rows(); ++i) {
     const Eigen::Vector3d p = points_world.row(i).transpose();
-    const Eigen::Vector3d p_top = f.world_to_top * p, p_bottom = f.world_to_bottom * p;
-    const double inside_hull = std::max(depth_inside(top_hull_, p_top, best), depth_inside(bottom_hull_, p_bottom, best));
-    if (inside_hull <= best) continue;
-    const double sd = std::max(top_.signed_distance(p_top), bottom_.signed_distance(p_bottom));
-    if (sd >= 0) continue;  // inside the object: penetration, not a cavity
-    best = std::max(best, std::min(inside_hull, -sd));
+    if (cavity_depth(state, p, std::max(floor, 0.0)) > floor) out.emplace_back(static_cast<int>(i), query(state, p));
   }
-  return best > floor ? best : 0.0;
+  return out;
 }
 
 ObjectSurfaceQuery ObjectDistance::query(const ObjectState& state, const Eigen::Vector3d& p_world,

@@ -21,10 +21,10 @@ struct Plane {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 };
 
-// The unit direction from a frame's inside vertices (signed distance > 0 in `near`, indices
-// into v) to the mean of the rest of the hand; zero when the hand is wholly inside or not
-// inside at all.
-Eigen::Vector3d exit_direction(const Points3& v, const std::vector<std::pair<int, ObjectSurfaceQuery>>& near);
+// The unit direction from a frame's trapped vertices (rows of v: inside the object, or in a
+// hollow part's cavity) to the mean of the rest of the hand; zero when the hand is wholly
+// trapped or not at all.
+Eigen::Vector3d exit_direction(const Points3& v, const std::vector<int>& trapped);
 
 // The plane where a ray from inside point p along unit e leaves the object, its normal
 // turned to face along e; none when the ray is still inside after kExitReach (a ray along a
@@ -33,5 +33,13 @@ Eigen::Vector3d exit_direction(const Points3& v, const std::vector<std::pair<int
 constexpr double kExitReach = 0.06;  // m
 std::optional<Plane> exit_plane(const ObjectDistance& dist, const ObjectState& state, Eigen::Vector3d p,
                                 const Eigen::Vector3d& e);
+
+// From a point outside the object (in a hollow part's cavity) along unit e: the plane where
+// the ray leaves the object after passing through it (a box's wall between a finger inside
+// the box and the rest of the hand outside); none when the ray meets no surface within
+// kExitReach (the way towards the hand is open: a hand reaching in through the opening) or
+// does not leave it within kExitReach after that.
+std::optional<Plane> exit_plane_through(const ObjectDistance& dist, const ObjectState& state, Eigen::Vector3d p,
+                                        const Eigen::Vector3d& e);
 
 }  // namespace bimart

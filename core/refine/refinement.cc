@@ -23,6 +23,7 @@
 #include "core/hand/keypoints.h"
 #include "core/hand/lbs.h"
 #include "core/hand/lbs_subset.h"
+#include "core/metrics/frame_depths.h"
 #include "core/refine/exit_plane.h"
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
@@ -37,7 +38,11 @@ constexpr int kJ = 100;
 constexpr int kX = kHandStateSize;
 constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
 constexpr double kClearanceTolerance = 0.0005;  // m
-constexpr int kSeparationPasses = 2;  // re-solves per round for frames that came near the gap
+constexpr int kSeparationPasses = 2;
+// m: a vertex in a cavity further than this behind the wall towards the rest of the hand is
+// left where it is (a hand inside a closed box is a generated motion gone wrong, not a
+// finger poked through a wall; pushed 4-6 cm out in one round, hands jumped)
+constexpr double kCavityReach = 0.02;  // re-solves per round for frames that came near the gap
 using Jet = ceres::Jet<double, kX>;
 
 // One frame's linearisation: the vertices posed (keypoints first, then the acceleration
@@ -67,6 +72,9 @@ struct HandData {
   std::vector<int> hold_part;  // per frame: -1, or the ObjectPart this hand is held to
   // Per frame: the penetration weight multiplier (grows while the frame stays too deep).
   std::vector<double> pen_boost;
+  // Per frame: a vertex was found in a cavity behind a wall (pen_cavities) in some round; its
+  // inside vertices then leave towards the rest of the hand whatever their depth.
+  std::vector<bool> through_wall;
   // Directions (RefineDirections): per frame clearance (m) and kept flags, the pins, the
   // wrist joint of the rest hand with this β (the wrist is at trans + j0), √(2 w_pin).
   std::vector<double> clearance;
@@ -479,6 +487,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
   std::vector<std::vector<std::pair<int, ObjectSurfaceQuery>>> frame_near(frame_v.size());
   std::vector<double> frame_depths(frame_v.size(), 0.0);
   std::vector<Eigen::Vector3d> exits(frame_v.size(), Eigen::Vector3d::Zero());
+  std::vector<std::vector<std::pair<int, Plane>>> frame_cavity(frame_v.size());  // pen_cavities
   for (int64_t t = 0; t < N; ++t) {
     const Points3 v = pose_all(all, d->x.data() + t * kX, d->beta.data());
     const ObjectState& st = d->states[static_cast<size_t>(t)];
@@ -523,16 +532,59 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     Points3 a(static_cast<Eigen::Index>(d->acc_ids.size()), 3);
     for (size_t i = 0; i < d->acc_ids.size(); ++i) a.row(static_cast<Eigen::Index>(i)) = v.row(d->acc_ids[i]);
     acc_points.push_back(std::move(a));
+    std::vector<int> inside;
+    for (const auto& [i, q] : near)
+      if (q.signed_distance > 0) inside.push_back(i);
+    // Vertices in a hollow part's cavity (pen_cavities) behind a wall from the rest of the
+    // hand: the wall between is a penetration the signed distance cannot see (a finger
+    // through a box's 5 mm wall is at most 2.5 mm inside it). Each gets the plane where a
+    // ray from it towards the rest of the hand leaves the wall, at its depth behind it;
+    // one whose ray meets nothing (the way is open: reaching in through the opening) none.
+    std::vector<std::pair<int, Plane>> cavity_planes;
+    Eigen::Vector3d cavity_way = Eigen::Vector3d::Zero();
+    double cavity_depth = 0;
+    if (o.pen_cavities) {
+      const auto cavity = dist.cavity_points(st, v, kCavityFloor);
+      if (!cavity.empty()) {
+        std::vector<int> trapped = inside;
+        for (const auto& [i, q] : cavity) trapped.push_back(i);
+        cavity_way = exit_direction(v, trapped);
+        for (const auto& [i, q] : cavity) {
+          if (cavity_way.isZero()) break;
+          const Eigen::Vector3d p = v.row(i).transpose();
+          const std::optional<Plane> wall = exit_plane_through(dist, st, p, cavity_way);
+          if (!wall) continue;
+          const double depth = wall->normal.dot(wall->point - p) + clear;
+          if (depth <= 0 || depth > kCavityReach) continue;
+          cavity_planes.emplace_back(i, *wall);
+          pen += depth * depth;
+          cavity_depth = std::max(cavity_depth, depth);
+          if (depth > e.max_depth) {
+            e.max_depth = depth;
+            e.deepest_frame = t;
+            e.deepest_vertex = i;
+          }
+        }
+      }
+    }
     if (!f) continue;
     frame_v[static_cast<size_t>(t)] = v;
     frame_near[static_cast<size_t>(t)] = near;
-    double frame_depth = 0;
+    double frame_depth = cavity_depth;
     for (const auto& [i, q] : near) frame_depth = std::max(frame_depth, q.signed_distance + clear);
     frame_depths[static_cast<size_t>(t)] = frame_depth;
     // A deep frame's inside vertices leave towards the hand's outside (exit_direction),
     // not each to its nearest surface: in a part thinner than twice their depth the
-    // nearest side flips between vertices and rounds, and the hand stays stuck in it.
-    if (frame_depth > o.pen_exit_depth) exits[static_cast<size_t>(t)] = exit_direction(v, near);
+    // nearest side flips between vertices and rounds, and the hand stays stuck in it. A
+    // frame with a finger through a wall leaves through it the same way as its cavity
+    // vertices.
+    if (!cavity_planes.empty()) {
+      exits[static_cast<size_t>(t)] = cavity_way;
+      d->through_wall[static_cast<size_t>(t)] = true;
+    } else if (frame_depth > o.pen_exit_depth || d->through_wall[static_cast<size_t>(t)]) {
+      exits[static_cast<size_t>(t)] = exit_direction(v, inside);
+    }
+    frame_cavity[static_cast<size_t>(t)] = std::move(cavity_planes);
   }
   // With pen_exit_smooth k: the way out of each frame within k frames of a deep one (and
   // with a vertex inside) is the mean of the deep frames' ways out within k frames. Frame by
@@ -584,10 +636,26 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     const double tolerance = clear > 0 ? std::min(o.pen_tolerance, kClearanceTolerance) : o.pen_tolerance;
     if (grow && frame_depth > tolerance) boost *= o.pen_growth;
     e.max_boost = std::max(e.max_boost, boost);
-    for (const auto& [i, q] : near) {
+    const auto& cavity = frame_cavity[static_cast<size_t>(t)];
+    for (const auto& [i, wall] : cavity) {
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
-      const bool turn = q.signed_distance > 0 && !exit.isZero() && q.normal.dot(exit) < 0;
-      const std::optional<Plane> out = turn ? exit_plane(dist, st, v.row(i).transpose(), exit) : std::nullopt;
+      f->pen.push_back(wall);
+      f->pen_scale.push_back(d->s_pen * boost);
+      f->pen_offset.push_back(clear);
+    }
+    for (const auto& [i, q] : near) {
+      // A cavity vertex's plane is beyond the wall: its nearest (the wall's inner face,
+      // facing the cavity) would hold it back there.
+      if (std::any_of(cavity.begin(), cavity.end(), [&, i = i](const auto& c) { return c.first == i; })) continue;
+      f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
+      const bool turn = !exit.isZero() && q.normal.dot(exit) < 0;
+      const Eigen::Vector3d p = v.row(i).transpose();
+      std::optional<Plane> out;
+      if (turn && q.signed_distance > 0) out = exit_plane(dist, st, p, exit);
+      // A frame through a wall: a vertex still in the cavity, near the wall's inside face,
+      // passes through the wall too (that face's plane would hold it in the box).
+      else if (turn && d->through_wall[static_cast<size_t>(t)] && dist.cavity_depth(st, p) > 0)
+        out = exit_plane_through(dist, st, p, exit);
       f->pen.push_back(out ? *out : plane_of(q));  // no exit within reach: the nearest surface
       f->pen_scale.push_back(d->s_pen * boost);
       f->pen_offset.push_back(clear);
@@ -750,6 +818,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   for (int64_t t = 0; t < d->N; ++t) params_of(*d, d->x.data() + t * kX, d->p_start.data() + t * kX);
   for (int p : d->hold_part) rep->held_frames += p >= 0;
   d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
+  d->through_wall.assign(static_cast<size_t>(d->N), false);
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
   rep->before = e.terms;
   rep->max_depth_before = e.max_depth;
@@ -792,7 +861,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
         const std::vector<Block> blocks = blocks_of(masks[static_cast<size_t>(d->kp_ids[static_cast<size_t>(f.hold_k)])]);
         problem.AddResidualBlock(new HoldCost(d, t, blocks), nullptr, block_pointers(x, blocks));
       }
-      const double grown = o.grow_constraints ? d->pen_boost[static_cast<size_t>(t)] : 1.0;
+      const double grown = std::pow(d->pen_boost[static_cast<size_t>(t)], o.constraint_growth);
       if (o.w_limits > 0)  // with bounded angles, only the thumb's box corners can be outside
         for (int g = d->angles ? 4 : 0; g < 5; ++g)
           problem.AddResidualBlock(new ceres::AutoDiffCostFunction<FingerLimitCost, 9, 9>(
@@ -890,7 +959,7 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
       int added = 0;
       for (int64_t t = 0; t < d->N; ++t)
         if (!separated[static_cast<size_t>(t)] && !d->is_kept(t) && near_gap(*d, t, o.separation_gap - kSeparationActive)) {
-          add_separation(t, o.grow_constraints ? d->pen_boost[static_cast<size_t>(t)] : 1.0);
+          add_separation(t, std::pow(d->pen_boost[static_cast<size_t>(t)], o.constraint_growth));
           ++added;
         }
       if (added == 0) break;
@@ -1005,6 +1074,7 @@ void RefineOptions::validate() const {
   nonneg(w_pose, "w_pose");
   nonneg(w_separation, "w_separation");
   nonneg(separation_gap, "separation_gap");
+  if (!(constraint_growth >= 0 && constraint_growth <= 1)) throw Error("refinement: constraint_growth must be in [0, 1]");
   nonneg(pen_margin, "pen_margin");
   if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");
   if (pen_exit_smooth < 0) throw Error("refinement: pen_exit_smooth must be >= 0 (frames)");

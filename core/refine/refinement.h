@@ -77,6 +77,13 @@ struct RefineOptions {
   // the way the deep frames there leave on average (0 = each deep frame its own way, the
   // others by their nearest planes)
   int pen_exit_smooth = 0;
+  // Hollow parts (ours; false: the paper's, the library default): hand vertices in a part's
+  // cavity (ObjectDistance::cavity_points, more than kCavityFloor in) whose way to the rest
+  // of the hand crosses a wall count as that far inside it, and leave through it
+  // (core/refine/exit_plane.h, exit_plane_through); in a frame found so once, the inside
+  // vertices leave the same way in later rounds, however shallow (a 5 mm wall holds a
+  // finger at most 2.5 mm deep: never deep enough for pen_exit_depth).
+  bool pen_cavities = false;
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
   double w_hold = 0;           // the hold term (ours; 0 = off, the paper's)
@@ -100,11 +107,11 @@ struct RefineOptions {
   // each other.
   double w_separation = 0;
   double separation_gap = 0.010;  // m (kFingerSeparation)
-  // The hand's other constraints grow with penetration (ours; false: the paper's, the
+  // The hand's other constraints grow with penetration (ours; 0: fixed, the paper's, the
   // library default): a frame's separation and joint-limit residuals are scaled by its
-  // penetration boost like its penetration rows, so a frame pushed hard out of the object
-  // does not buy it with fingers inside each other or past their ranges.
-  bool grow_constraints = false;
+  // penetration boost to this power (1: as its penetration rows), so a frame pushed hard
+  // out of the object does not buy it with fingers inside each other or past their ranges.
+  double constraint_growth = 0;
   // Finger joints as bounded angles (ours, off by default): each joint's flexion, abduction
   // and twist (JointLimits::rotation) are the solver's parameters, bounded by their
   // anatomical ranges, so every step stays inside them (the thumb's box corners, outside its

@@ -41,6 +41,8 @@ class CeresRefineStage : public Refiner {
                    "m: frames deeper than this push inside vertices out towards the rest of the hand (1e9 = off)")
             .param("pen_exit_smooth", std::int64_t{d.pen_exit_smooth},
                    "frames: frames this near a deep one leave the way the deep ones there do on average (0: each its own)")
+            .param("pen_cavities", d.pen_cavities,
+                   "hand vertices in a hollow part's cavity behind a wall leave through it (ours; false: the paper's)")
             .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
             .param("pen_growth", d.pen_growth, "factor of that growth per round")
             .param("accel_vertices", d.accel_vertices, "hand vertices in the acceleration term (>= 32)")
@@ -56,8 +58,8 @@ class CeresRefineStage : public Refiner {
             .param("w_separation", d.w_separation,
                    "fingers apart: two fingers' bones at least separation_gap apart (ours; 0 = off, the paper's)")
             .param("separation_gap", d.separation_gap, "m, the least distance between two fingers' bone axes")
-            .param("grow_constraints", d.grow_constraints,
-                   "a frame's separation and joint-limit terms grow with its penetration weight (ours; false: fixed)")
+            .param("constraint_growth", d.constraint_growth,
+                   "a frame's separation and joint-limit terms grow with its penetration weight to this power (ours; 0: fixed)")
             .param("joint_angles", d.joint_angles,
                    "finger joints as angles bounded by their anatomical ranges (ours; false: axis-angles, the paper's)")
             .param("backtrack", d.backtrack,
@@ -82,6 +84,7 @@ class CeresRefineStage : public Refiner {
     o_.pen_margin = p.number("pen_margin");
     o_.pen_exit_depth = p.number("pen_exit_depth");
     o_.pen_exit_smooth = static_cast<int>(p.integer("pen_exit_smooth"));
+    o_.pen_cavities = p.boolean("pen_cavities");
     o_.pen_tolerance = p.number("pen_tolerance");
     o_.pen_growth = p.number("pen_growth");
     o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));
@@ -91,7 +94,7 @@ class CeresRefineStage : public Refiner {
     o_.w_pose = p.number("w_pose");
     o_.w_separation = p.number("w_separation");
     o_.separation_gap = p.number("separation_gap");
-    o_.grow_constraints = p.boolean("grow_constraints");
+    o_.constraint_growth = p.number("constraint_growth");
     o_.joint_angles = p.boolean("joint_angles");
     o_.backtrack = p.boolean("backtrack");
     o_.validate();

@@ -58,14 +58,51 @@ TEST(ExitPlane, TheWayOutPointsFromTheInsideVerticesToTheRest) {
       0.01, 0, -0.005,  //
       0, 0, 0.02,       //
       0.01, 0, 0.04;
-  ObjectSurfaceQuery in, out;
-  in.signed_distance = 0.005;
-  out.signed_distance = -0.02;
-  const Eigen::Vector3d e = exit_direction(v, {{0, in}, {1, in}, {2, out}});
+  const Eigen::Vector3d e = exit_direction(v, {0, 1});
   EXPECT_NEAR(e.x(), 0.0, 1e-12);
   EXPECT_NEAR(e.z(), 1.0, 1e-12);  // from (0.005, 0, -0.005) to (0.005, 0, 0.03)
-  EXPECT_TRUE(exit_direction(v, {{2, out}}).isZero());                          // nothing inside
-  EXPECT_TRUE(exit_direction(v, {{0, in}, {1, in}, {2, in}, {3, in}}).isZero());  // wholly inside
+  EXPECT_TRUE(exit_direction(v, {}).isZero());            // nothing trapped
+  EXPECT_TRUE(exit_direction(v, {0, 1, 2, 3}).isZero());  // wholly trapped
+}
+
+// A closed box of 5 mm walls, 20 × 20 × 10 cm, its lid the top part (its top face z = 0).
+ArticulatedObject hollow_box() {
+  ArticulatedObject o;
+  o.name = "hollow_box";
+  const double X = 0.1, T = 0.005, Z = -0.1;
+  shapes::append(o.bottom, shapes::rounded_box({-X, -X, Z}, {X, X, Z + T}, 0.001, 0.01));            // floor
+  shapes::append(o.bottom, shapes::rounded_box({-X, -X, Z + T}, {-X + T, X, -T}, 0.001, 0.01));      // walls
+  shapes::append(o.bottom, shapes::rounded_box({X - T, -X, Z + T}, {X, X, -T}, 0.001, 0.01));
+  shapes::append(o.bottom, shapes::rounded_box({-X + T, -X, Z + T}, {X - T, -X + T, -T}, 0.001, 0.01));
+  shapes::append(o.bottom, shapes::rounded_box({-X + T, X - T, Z + T}, {X - T, X, -T}, 0.001, 0.01));
+  o.top = shapes::rounded_box({-X, -X, -T}, {X, X, 0.0}, 0.001, 0.01);
+  return o;
+}
+
+TEST(ExitPlane, FromACavityThroughTheWallBetween) {
+  const ObjectDistance dist(hollow_box());
+  const Eigen::Vector3d p(0.0, -0.07, -0.05);  // in the box, 2.5 cm from the front wall's inside (y = -0.095)
+  ASSERT_LT(dist.query(ObjectState{}, p).signed_distance, -0.02);
+  // Towards the front: the plane is the wall's outside face, y = -0.1, facing out.
+  const auto front = exit_plane_through(dist, ObjectState{}, p, -Eigen::Vector3d::UnitY());
+  ASSERT_TRUE(front.has_value());
+  EXPECT_NEAR(front->point.y(), -0.1, 5e-4);
+  EXPECT_LT(front->normal.y(), -0.99);
+  // Up: through the lid, its top face z = 0.
+  const auto up = exit_plane_through(dist, ObjectState{}, p, Eigen::Vector3d::UnitZ());
+  ASSERT_TRUE(up.has_value());
+  EXPECT_NEAR(up->point.z(), 0.0, 5e-4);
+  // Far out of the box, pointing away from it: nothing to pass through.
+  EXPECT_FALSE(exit_plane_through(dist, ObjectState{}, Eigen::Vector3d(0, -0.2, -0.05), -Eigen::Vector3d::UnitY()));
+  // The lid open (the top part far away): up through the opening, no wall.
+  ArticulatedObject open = hollow_box();
+  open.top = shapes::rounded_box({1.0, 1.0, 1.0}, {1.05, 1.05, 1.05}, 0.005, 0.01);
+  const ObjectDistance open_dist(open);
+  EXPECT_FALSE(exit_plane_through(open_dist, ObjectState{}, p, Eigen::Vector3d::UnitZ()).has_value());
+  // The cavity as the distance reads it: the point is in it, 2.5 cm deep, the wall is not.
+  const auto cavity = dist.cavity_points(ObjectState{}, (Points3(2, 3) << p.transpose(), 0, -0.0975, -0.05).finished(), 0.005);
+  ASSERT_EQ(cavity.size(), 1u);
+  EXPECT_EQ(cavity[0].first, 0);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "core/refine/hand_state.h"
 #include "core/refine/mano_fit.h"
 #include "core/util/error.h"
+#include "core/util/log.h"
 #include "tests/refine/known_motion.h"
 #include "tests/synth/shipped_hands.h"
 
@@ -212,6 +213,53 @@ TEST(Refinement, AHandSunkPastTheMiddleOfAThinPartLeavesOnItsOwnSide) {
   EXPECT_THROW(nearest.validate(), Error);
   smoothed.pen_exit_smooth = -1;
   EXPECT_THROW(smoothed.validate(), Error);
+}
+
+// A hollow part: a closed box of 5 mm walls, its lid the top part (top face z = 0). Hands
+// predicted 1.5 cm into it have their palms in the box: the lid holds at most 2.5 mm of
+// them, so the signed distance barely sees it. With pen_cavities the vertices in the box
+// leave through the lid, on top; without, the hands stay in the box.
+TEST(Refinement, AHandThroughAHollowPartsWallLeavesThroughIt) {
+  const auto& models = test::shipped_hands();
+  ArticulatedObject object;
+  object.name = "hollow_box";
+  const double X = 0.3, T = 0.005, Z = -0.1;  // both hands well inside the lid's edges
+  shapes::append(object.bottom, shapes::rounded_box({-X, -X, Z}, {X, X, Z + T}, 0.001, 0.01));
+  shapes::append(object.bottom, shapes::rounded_box({-X, -X, Z + T}, {-X + T, X, -T}, 0.001, 0.01));
+  shapes::append(object.bottom, shapes::rounded_box({X - T, -X, Z + T}, {X, X, -T}, 0.001, 0.01));
+  shapes::append(object.bottom, shapes::rounded_box({-X + T, -X, Z + T}, {X - T, -X + T, -T}, 0.001, 0.01));
+  shapes::append(object.bottom, shapes::rounded_box({-X + T, X - T, Z + T}, {X - T, X, -T}, 0.001, 0.01));
+  object.top = shapes::rounded_box({-X, -X, -T}, {X, X, 0.0}, 0.001, 0.01);
+  const ObjectDistance distance(object);
+  const PushedHands c = pushed_into_the_slab(object, 4, 0.015f);
+  const auto deepest_cavity = [&](const HandMotion& m) {
+    double worst = 0;
+    for (int h = 0; h < 2; ++h)
+      for (int t = 0; t < 4; ++t) {
+        const at::Tensor v = m.vertices[h][t].to(at::kDouble).contiguous();
+        worst = std::max(worst, distance.max_cavity_depth(ObjectState{}, Eigen::Map<const Points3>(v.data_ptr<double>(), v.size(0), 3)));
+      }
+    return worst;
+  };
+  RefineOptions with, without;
+  with.w_proj = without.w_proj = 0;  // penetration alone, as above
+  with.pen_cavities = true;
+  with.max_outer_iterations = without.max_outer_iterations = 6;  // as the pipelines
+  RefineReport r_with, r_without;
+  log::setup(getenv("REFINE_DEBUG") ? 1 : 0);
+  const HandMotion out = refine_hands(models, distance, c.states, c.pushed, c.fit, with, &r_with);
+  const HandMotion in = refine_hands(models, distance, c.states, c.pushed, c.fit, without, &r_without);
+  std::printf("with:\n%swithout:\n%s", format_refine_report(r_with).c_str(), format_refine_report(r_without).c_str());
+  const double before = deepest_cavity(c.fit), after_with = deepest_cavity(out), after_without = deepest_cavity(in);
+  std::printf("deepest in the box: fit %.1f mm, with %.1f mm, without %.1f mm\n", before * 1e3, after_with * 1e3,
+              after_without * 1e3);
+  EXPECT_GT(before, 0.006);
+  EXPECT_GT(after_without, 0.006);
+  EXPECT_EQ(after_with, 0.0);
+  for (int h = 0; h < 2; ++h) {
+    EXPECT_LE(r_with.hands[h].max_depth_after, with.pen_tolerance) << "hand " << h;
+    EXPECT_GT(out.vertices[h].select(2, 2).min().item<double>(), -0.003) << "hand " << h;  // on the lid
+  }
 }
 
 // The hold term: hands predicted 3 cm above the slab (no projection term, which would also
