@@ -38,11 +38,7 @@ constexpr int kJ = 100;
 constexpr int kX = kHandStateSize;
 constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
 constexpr double kClearanceTolerance = 0.0005;  // m
-constexpr int kSeparationPasses = 2;
-// m: a vertex in a cavity further than this behind the wall towards the rest of the hand is
-// left where it is (a hand inside a closed box is a generated motion gone wrong, not a
-// finger poked through a wall; pushed 4-6 cm out in one round, hands jumped)
-constexpr double kCavityReach = 0.02;  // re-solves per round for frames that came near the gap
+constexpr int kSeparationPasses = 2;  // re-solves per round for frames that came near the gap
 using Jet = ceres::Jet<double, kX>;
 
 // One frame's linearisation: the vertices posed (keypoints first, then the acceleration
@@ -555,7 +551,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
           const std::optional<Plane> wall = exit_plane_through(dist, st, p, cavity_way);
           if (!wall) continue;
           const double depth = wall->normal.dot(wall->point - p) + clear;
-          if (depth <= 0 || depth > kCavityReach) continue;
+          if (depth <= 0) continue;
           cavity_planes.emplace_back(i, *wall);
           pen += depth * depth;
           cavity_depth = std::max(cavity_depth, depth);
@@ -634,7 +630,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     // A clearance is a promise to the animator (`bimart constraints` allows it 1 mm): its
     // frames grow their weight from kClearanceTolerance on, not from pen_tolerance.
     const double tolerance = clear > 0 ? std::min(o.pen_tolerance, kClearanceTolerance) : o.pen_tolerance;
-    if (grow && frame_depth > tolerance) boost *= o.pen_growth;
+    if (grow && frame_depth > tolerance) boost = std::min(boost * o.pen_growth, std::max(o.max_pen_boost, 1.0));
     e.max_boost = std::max(e.max_boost, boost);
     const auto& cavity = frame_cavity[static_cast<size_t>(t)];
     for (const auto& [i, wall] : cavity) {
@@ -1074,6 +1070,7 @@ void RefineOptions::validate() const {
   nonneg(w_pose, "w_pose");
   nonneg(w_separation, "w_separation");
   nonneg(separation_gap, "separation_gap");
+  if (!(max_pen_boost >= 1)) throw Error("refinement: max_pen_boost must be >= 1");
   if (!(constraint_growth >= 0 && constraint_growth <= 1)) throw Error("refinement: constraint_growth must be in [0, 1]");
   nonneg(pen_margin, "pen_margin");
   if (!(pen_exit_depth >= 0)) throw Error("refinement: pen_exit_depth must be >= 0 (metres; 1e9 = off)");

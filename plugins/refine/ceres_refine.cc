@@ -45,6 +45,7 @@ class CeresRefineStage : public Refiner {
                    "hand vertices in a hollow part's cavity behind a wall leave through it (ours; false: the paper's)")
             .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
             .param("pen_growth", d.pen_growth, "factor of that growth per round")
+            .param("max_pen_boost", d.max_pen_boost, "the largest that growth makes a frame's penetration weight (x w_pen)")
             .param("accel_vertices", d.accel_vertices, "hand vertices in the acceleration term (>= 32)")
             .param("threads", d.threads, "0: all cores (one hand per thread)")
             .param("w_hold", d.w_hold,
@@ -87,6 +88,7 @@ class CeresRefineStage : public Refiner {
     o_.pen_cavities = p.boolean("pen_cavities");
     o_.pen_tolerance = p.number("pen_tolerance");
     o_.pen_growth = p.number("pen_growth");
+    o_.max_pen_boost = p.number("max_pen_boost");
     o_.accel_vertices = static_cast<int>(p.integer("accel_vertices"));
     o_.threads = static_cast<int>(p.integer("threads"));
     o_.w_hold = p.number("w_hold");

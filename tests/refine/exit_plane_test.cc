@@ -8,18 +8,13 @@
 #include <gtest/gtest.h>
 
 #include "core/object/families/primitives.h"
+#include "tests/refine/test_objects.h"
 
 namespace bimart {
 namespace {
 
-// A 40 × 40 cm slab 1 cm thick, top face z = 0 (bottom part), and a small lid far away.
-ArticulatedObject thin_slab() {
-  ArticulatedObject o;
-  o.name = "thin_slab";
-  o.bottom = shapes::rounded_box({-0.2, -0.2, -0.01}, {0.2, 0.2, 0.0}, 0.002, 0.01);
-  o.top = shapes::rounded_box({1.0, 1.0, 1.0}, {1.05, 1.05, 1.05}, 0.005, 0.01);
-  return o;
-}
+// A slab 1 cm thick, top face z = 0.
+ArticulatedObject thin_slab() { return test::slab(0.01, 0.002); }
 
 TEST(ExitPlane, ARayLeavesThroughTheFaceItMeets) {
   const ObjectDistance dist(thin_slab());
@@ -66,18 +61,7 @@ TEST(ExitPlane, TheWayOutPointsFromTheInsideVerticesToTheRest) {
 }
 
 // A closed box of 5 mm walls, 20 × 20 × 10 cm, its lid the top part (its top face z = 0).
-ArticulatedObject hollow_box() {
-  ArticulatedObject o;
-  o.name = "hollow_box";
-  const double X = 0.1, T = 0.005, Z = -0.1;
-  shapes::append(o.bottom, shapes::rounded_box({-X, -X, Z}, {X, X, Z + T}, 0.001, 0.01));            // floor
-  shapes::append(o.bottom, shapes::rounded_box({-X, -X, Z + T}, {-X + T, X, -T}, 0.001, 0.01));      // walls
-  shapes::append(o.bottom, shapes::rounded_box({X - T, -X, Z + T}, {X, X, -T}, 0.001, 0.01));
-  shapes::append(o.bottom, shapes::rounded_box({-X + T, -X, Z + T}, {X - T, -X + T, -T}, 0.001, 0.01));
-  shapes::append(o.bottom, shapes::rounded_box({-X + T, X - T, Z + T}, {X - T, X, -T}, 0.001, 0.01));
-  o.top = shapes::rounded_box({-X, -X, -T}, {X, X, 0.0}, 0.001, 0.01);
-  return o;
-}
+ArticulatedObject hollow_box() { return test::hollow_box(0.1); }
 
 TEST(ExitPlane, FromACavityThroughTheWallBetween) {
   const ObjectDistance dist(hollow_box());

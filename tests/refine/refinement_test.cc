@@ -19,20 +19,14 @@
 #include "core/util/error.h"
 #include "core/util/log.h"
 #include "tests/refine/known_motion.h"
+#include "tests/refine/test_objects.h"
 #include "tests/synth/shipped_hands.h"
 
 namespace bimart {
 namespace {
 
-// A 40 × 40 × 10 cm slab (rounded edges) whose top face is z = 0 (bottom part) and a small lid far away.
-ArticulatedObject slab() {
-  ArticulatedObject o;
-  o.name = "slab";
-  // Dense (1 cm spacing): D points to the nearest object vertex, as on real objects.
-  o.bottom = shapes::rounded_box({-0.2, -0.2, -0.1}, {0.2, 0.2, 0.0}, 0.005, 0.01);
-  o.top = shapes::rounded_box({1.0, 1.0, 1.0}, {1.05, 1.05, 1.05}, 0.005, 0.01);
-  return o;
-}
+// A 40 × 40 × 10 cm slab whose top face is z = 0 (bottom part) and a small lid far away.
+ArticulatedObject slab() { return test::slab(); }
 
 // Hand features X of keypoints H [2, N, 100, 3] (rows 0..99 are the keypoints).
 at::Tensor keypoint_features(const at::Tensor& H, const ArticulatedObject& object, const at::Tensor& states) {
@@ -181,8 +175,7 @@ TEST(Refinement, HeldFingerPoseMovesTheHandInsteadOfTheFingers) {
 // stay stuck; pushed towards the rest of the hand (pen_exit_depth) they all leave on top.
 TEST(Refinement, AHandSunkPastTheMiddleOfAThinPartLeavesOnItsOwnSide) {
   const auto& models = test::shipped_hands();
-  ArticulatedObject object = slab();
-  object.bottom = shapes::rounded_box({-0.2, -0.2, -0.02}, {0.2, 0.2, 0.0}, 0.005, 0.01);
+  const ArticulatedObject object = test::slab(0.02);
   const ObjectDistance distance(object);
   const PushedHands c = pushed_into_the_slab(object, 4, 0.015f);
   RefineOptions exit, nearest;
@@ -221,15 +214,7 @@ TEST(Refinement, AHandSunkPastTheMiddleOfAThinPartLeavesOnItsOwnSide) {
 // leave through the lid, on top; without, the hands stay in the box.
 TEST(Refinement, AHandThroughAHollowPartsWallLeavesThroughIt) {
   const auto& models = test::shipped_hands();
-  ArticulatedObject object;
-  object.name = "hollow_box";
-  const double X = 0.3, T = 0.005, Z = -0.1;  // both hands well inside the lid's edges
-  shapes::append(object.bottom, shapes::rounded_box({-X, -X, Z}, {X, X, Z + T}, 0.001, 0.01));
-  shapes::append(object.bottom, shapes::rounded_box({-X, -X, Z + T}, {-X + T, X, -T}, 0.001, 0.01));
-  shapes::append(object.bottom, shapes::rounded_box({X - T, -X, Z + T}, {X, X, -T}, 0.001, 0.01));
-  shapes::append(object.bottom, shapes::rounded_box({-X + T, -X, Z + T}, {X - T, -X + T, -T}, 0.001, 0.01));
-  shapes::append(object.bottom, shapes::rounded_box({-X + T, X - T, Z + T}, {X - T, X, -T}, 0.001, 0.01));
-  object.top = shapes::rounded_box({-X, -X, -T}, {X, X, 0.0}, 0.001, 0.01);
+  const ArticulatedObject object = test::hollow_box(0.3);  // both hands well inside the lid's edges
   const ObjectDistance distance(object);
   const PushedHands c = pushed_into_the_slab(object, 4, 0.015f);
   const auto deepest_cavity = [&](const HandMotion& m) {
