@@ -287,6 +287,14 @@ void add_refine_commands(CLI::App& app, Commands& out) {
                   "refinement: frames deeper than this (m) push inside vertices out towards the rest of the hand (1e9 = off)")
       ->capture_default_str();
   cmd->add_option("--rounds", o.refine.outer_iterations, "refinement: surface linearisations")->capture_default_str();
+  cmd->add_option("--max-rounds", o.refine.max_outer_iterations,
+                  "refinement: rounds while a frame is deeper than 2 mm (the pipelines: 6)")
+      ->capture_default_str();
+  cmd->add_option("--max-pen-boost", o.refine.max_pen_boost,
+                  "refinement: the largest that a frame's penetration weight grows to, x w_pen (default: no cap; the pipelines: 1000)");
+  cmd->add_option("--pen-cavities", o.refine.pen_cavities,
+                  "refinement: hand vertices in a hollow part's cavity behind a wall leave through it (the pipelines: true)")
+      ->capture_default_str();
   cmd->add_option("--steps", o.refine.max_iterations, "refinement: solver steps per round")->capture_default_str();
   cmd->add_option("--noise", o.corruption.noise, "corruption: RMS keypoint error (m)")->capture_default_str();
   cmd->add_option("--jitter", o.corruption.jitter, "corruption: RMS per-frame hand offset (m)")->capture_default_str();
