@@ -79,14 +79,12 @@ double ObjectDistance::max_cavity_depth(const ObjectState& state, const Points3&
   return best > floor ? best : 0.0;
 }
 
-std::vector<std::pair<int, ObjectSurfaceQuery>> ObjectDistance::cavity_points(const ObjectState& state,
-                                                                              const Points3& points_world,
-                                                                              double floor) const {
-  std::vector<std::pair<int, ObjectSurfaceQuery>> out;
-  for (Eigen::Index i = 0; i < points_world.rows(); ++i) {
-    const Eigen::Vector3d p = points_world.row(i).transpose();
-    if (cavity_depth(state, p, std::max(floor, 0.0)) > floor) out.emplace_back(static_cast<int>(i), query(state, p));
-  }
+std::vector<int> ObjectDistance::cavity_points(const ObjectState& state, const Points3& points_world,
+                                               double floor) const {
+  std::vector<int> out;
+  for (Eigen::Index i = 0; i < points_world.rows(); ++i)
+    if (cavity_depth(state, points_world.row(i).transpose(), std::max(floor, 0.0)) > floor)
+      out.push_back(static_cast<int>(i));
   return out;
 }
 

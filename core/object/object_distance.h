@@ -57,10 +57,8 @@ class ObjectDistance {
   // One point's cavity depth (as max_cavity_depth), or 0 (also when it is no more than
   // `stop`: then the object is not queried).
   double cavity_depth(const ObjectState& state, const Eigen::Vector3d& p, double stop = 0) const;
-  // The points (rows) in a cavity deeper than `floor` (as max_cavity_depth measures it), with
-  // their queries (the nearest surface; signed distance < 0).
-  std::vector<std::pair<int, ObjectSurfaceQuery>> cavity_points(const ObjectState& state, const Points3& points_world,
-                                                                double floor) const;
+  // The points (rows) in a cavity deeper than `floor` (as max_cavity_depth measures it).
+  std::vector<int> cavity_points(const ObjectState& state, const Points3& points_world, double floor) const;
 
   const MeshDistance& top() const { return top_; }
   const MeshDistance& bottom() const { return bottom_; }

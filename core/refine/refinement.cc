@@ -543,9 +543,9 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
       const auto cavity = dist.cavity_points(st, v, kCavityFloor);
       if (!cavity.empty()) {
         std::vector<int> trapped = inside;
-        for (const auto& [i, q] : cavity) trapped.push_back(i);
+        trapped.insert(trapped.end(), cavity.begin(), cavity.end());
         cavity_way = exit_direction(v, trapped);
-        for (const auto& [i, q] : cavity) {
+        for (const int i : cavity) {
           if (cavity_way.isZero()) break;
           const Eigen::Vector3d p = v.row(i).transpose();
           const std::optional<Plane> wall = exit_plane_through(dist, st, p, cavity_way);
@@ -633,7 +633,9 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     if (grow && frame_depth > tolerance) boost = std::min(boost * o.pen_growth, std::max(o.max_pen_boost, 1.0));
     e.max_boost = std::max(e.max_boost, boost);
     const auto& cavity = frame_cavity[static_cast<size_t>(t)];
+    std::vector<bool> has_wall(static_cast<size_t>(V), false);
     for (const auto& [i, wall] : cavity) {
+      has_wall[static_cast<size_t>(i)] = true;
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
       f->pen.push_back(wall);
       f->pen_scale.push_back(d->s_pen * boost);
@@ -642,7 +644,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     for (const auto& [i, q] : near) {
       // A cavity vertex's plane is beyond the wall: its nearest (the wall's inner face,
       // facing the cavity) would hold it back there.
-      if (std::any_of(cavity.begin(), cavity.end(), [&, i = i](const auto& c) { return c.first == i; })) continue;
+      if (has_wall[static_cast<size_t>(i)]) continue;
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
       const bool turn = !exit.isZero() && q.normal.dot(exit) < 0;
       const Eigen::Vector3d p = v.row(i).transpose();

@@ -86,7 +86,7 @@ TEST(ExitPlane, FromACavityThroughTheWallBetween) {
   // The cavity as the distance reads it: the point is in it, 2.5 cm deep, the wall is not.
   const auto cavity = dist.cavity_points(ObjectState{}, (Points3(2, 3) << p.transpose(), 0, -0.0975, -0.05).finished(), 0.005);
   ASSERT_EQ(cavity.size(), 1u);
-  EXPECT_EQ(cavity[0].first, 0);
+  EXPECT_EQ(cavity[0], 0);
 }
 
 }  // namespace
