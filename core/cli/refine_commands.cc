@@ -295,6 +295,9 @@ void add_refine_commands(CLI::App& app, Commands& out) {
   cmd->add_option("--pen-cavities", o.refine.pen_cavities,
                   "refinement: hand vertices in a hollow part's cavity behind a wall leave through it (the pipelines: true)")
       ->capture_default_str();
+  cmd->add_option("--pen-fingers-through", o.refine.pen_fingers_through,
+                  "refinement: a finger through a thin part comes back through it whole")
+      ->capture_default_str();
   cmd->add_option("--steps", o.refine.max_iterations, "refinement: solver steps per round")->capture_default_str();
   cmd->add_option("--noise", o.corruption.noise, "corruption: RMS keypoint error (m)")->capture_default_str();
   cmd->add_option("--jitter", o.corruption.jitter, "corruption: RMS per-frame hand offset (m)")->capture_default_str();

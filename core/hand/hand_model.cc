@@ -49,6 +49,21 @@ void check_bounded(const char* name, const M& m, double bound, const char* unit)
 
 }  // namespace
 
+int skinning_joint(const HandModel& m, int vertex) {
+  Eigen::Index j = 0;
+  m.weights.row(vertex).maxCoeff(&j);
+  return static_cast<int>(j);
+}
+
+std::vector<int> vertex_fingers(const HandModel& m) {
+  std::vector<int> f(static_cast<size_t>(m.num_vertices()));
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const int j = skinning_joint(m, v);
+    f[static_cast<size_t>(v)] = j == 0 ? 0 : (j - 1) / 3 + 1;
+  }
+  return f;
+}
+
 int HandModel::num_vertices() const { return static_cast<int>(v_template.rows()); }
 int HandModel::num_faces() const { return static_cast<int>(faces.rows()); }
 

@@ -42,6 +42,12 @@ struct HandModel {
   void validate() const;
 };
 
+// The joint each vertex follows most (its largest skinning weight), MANO order.
+int skinning_joint(const HandModel& m, int vertex);
+// Each vertex's finger by that joint: 0 the palm (the wrist's), 1 index, 2 middle, 3 pinky,
+// 4 ring, 5 thumb (MANO order).
+std::vector<int> vertex_fingers(const HandModel& m);
+
 // Reads and validates a hand model .npz; throws bimart::Error naming the file and key.
 HandModel load_hand_model(const std::string& npz_path);
 // Both hands, {left, right}: load_hand_model of each, and an error naming the file when a

@@ -10,16 +10,6 @@
 #include "core/util/error.h"
 
 namespace bimart {
-namespace {
-
-int skinning_joint(const HandModel& m, int vertex) {
-  Eigen::Index j = 0;
-  m.weights.row(vertex).maxCoeff(&j);
-  return static_cast<int>(j);
-}
-
-}  // namespace
-
 std::vector<HandFrameRow> hand_frame_rows(const ObjectDistance& distance, const at::Tensor& states_in,
                                           const at::Tensor& vertices_in, const std::array<const HandModel*, 2>& models) {
   const at::Tensor states = states_in.to(at::kCPU, at::kDouble).contiguous();

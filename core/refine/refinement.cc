@@ -4,6 +4,7 @@
 #include <ceres/rotation.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <map>
 #include <optional>
@@ -38,6 +39,9 @@ constexpr int kJ = 100;
 constexpr int kX = kHandStateSize;
 constexpr double kLeverFinger = 0.03;  // m: finger angles as lengths (as the MANO fit)
 constexpr double kClearanceTolerance = 0.0005;  // m
+// m: pen_fingers_through moves a vertex through a part at most this far (a finger's tip
+// beyond a thin part: the margin, 1.5 cm, and a part as thick as a finger).
+constexpr double kThroughReach = 0.03;
 constexpr int kSeparationPasses = 2;  // re-solves per round for frames that came near the gap
 using Jet = ceres::Jet<double, kX>;
 
@@ -71,6 +75,7 @@ struct HandData {
   // Per frame: a vertex was found in a cavity behind a wall (pen_cavities) in some round; its
   // inside vertices then leave towards the rest of the hand whatever their depth.
   std::vector<bool> through_wall;
+  std::vector<int> finger_of;  // per row of the all-vertex subset: vertex_fingers
   // Directions (RefineDirections): per frame clearance (m) and kept flags, the pins, the
   // wrist joint of the rest hand with this β (the wrist is at trans + j0), √(2 w_pin).
   std::vector<double> clearance;
@@ -633,6 +638,10 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     if (grow && frame_depth > tolerance) boost = std::min(boost * o.pen_growth, std::max(o.max_pen_boost, 1.0));
     e.max_boost = std::max(e.max_boost, boost);
     const auto& cavity = frame_cavity[static_cast<size_t>(t)];
+    std::array<bool, 6> finger_inside{};  // pen_fingers_through: fingers (and palm) with a vertex inside
+    if (o.pen_fingers_through && !exit.isZero())
+      for (const auto& [i, q] : near)
+        if (q.signed_distance > 0) finger_inside[static_cast<size_t>(d->finger_of[static_cast<size_t>(i)])] = true;
     std::vector<bool> has_wall(static_cast<size_t>(V), false);
     for (const auto& [i, wall] : cavity) {
       has_wall[static_cast<size_t>(i)] = true;
@@ -654,6 +663,12 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
       // passes through the wall too (that face's plane would hold it in the box).
       else if (turn && d->through_wall[static_cast<size_t>(t)] && dist.cavity_depth(st, p) > 0)
         out = exit_plane_through(dist, st, p, exit);
+      // A finger through a thin part: its vertices beyond the part go back through it with
+      // the rest of the finger (the nearest face would hold them beyond).
+      else if (turn && finger_inside[static_cast<size_t>(d->finger_of[static_cast<size_t>(i)])]) {
+        out = exit_plane_through(dist, st, p, exit);
+        if (out && out->normal.dot(out->point - p) > kThroughReach) out.reset();
+      }
       f->pen.push_back(out ? *out : plane_of(q));  // no exit within reach: the nearest surface
       f->pen_scale.push_back(d->s_pen * boost);
       f->pen_offset.push_back(clear);
@@ -817,6 +832,9 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
   for (int p : d->hold_part) rep->held_frames += p >= 0;
   d->pen_boost.assign(static_cast<size_t>(d->N), 1.0);
   d->through_wall.assign(static_cast<size_t>(d->N), false);
+  const std::vector<int> fingers = vertex_fingers(*d->model);
+  d->finger_of.clear();
+  for (const int vid : all.vertex_ids) d->finger_of.push_back(fingers[static_cast<size_t>(vid)]);
   Evaluation e = timed_evaluate(o.outer_iterations > 0, false);
   rep->before = e.terms;
   rep->max_depth_before = e.max_depth;

@@ -90,6 +90,14 @@ struct RefineOptions {
   // vertices leave the same way in later rounds, however shallow (a 5 mm wall holds a
   // finger at most 2.5 mm deep: never deep enough for pen_exit_depth).
   bool pen_cavities = false;
+  // Fingers through a thin part (ours; false: the paper's, the library default): in a frame
+  // that leaves the object one way (pen_exit_depth), an outside vertex whose nearest face
+  // faces away from that way, of a finger (or the palm) with a vertex inside, takes the
+  // plane where a ray from it along the way passes through the part (exit_plane_through),
+  // within kThroughReach. Without it a finger through a notebook's cover is locked there:
+  // its inside vertices are pushed up, its tip below is held below by the bottom face, and
+  // the finger settles across the cover's middle plane (6.4 mm deep in a 12.8 mm cover).
+  bool pen_fingers_through = false;
   int accel_vertices = 48;     // vertices per hand in the acceleration term
   int threads = 0;             // 0: all cores (the hands run in parallel)
   double w_hold = 0;           // the hold term (ours; 0 = off, the paper's)

@@ -43,6 +43,8 @@ class CeresRefineStage : public Refiner {
                    "frames: frames this near a deep one leave the way the deep ones there do on average (0: each its own)")
             .param("pen_cavities", d.pen_cavities,
                    "hand vertices in a hollow part's cavity behind a wall leave through it (ours; false: the paper's)")
+            .param("pen_fingers_through", d.pen_fingers_through,
+                   "a finger through a thin part comes back through it whole (ours; false: the paper's)")
             .param("pen_tolerance", d.pen_tolerance, "m: frames deeper than this get a larger penetration weight")
             .param("pen_growth", d.pen_growth, "factor of that growth per round")
             .param("max_pen_boost", d.max_pen_boost, "the largest that growth makes a frame's penetration weight (x w_pen)")
@@ -86,6 +88,7 @@ class CeresRefineStage : public Refiner {
     o_.pen_exit_depth = p.number("pen_exit_depth");
     o_.pen_exit_smooth = static_cast<int>(p.integer("pen_exit_smooth"));
     o_.pen_cavities = p.boolean("pen_cavities");
+    o_.pen_fingers_through = p.boolean("pen_fingers_through");
     o_.pen_tolerance = p.number("pen_tolerance");
     o_.pen_growth = p.number("pen_growth");
     o_.max_pen_boost = p.number("max_pen_boost");

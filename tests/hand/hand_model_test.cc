@@ -8,6 +8,7 @@
 
 #include "core/io/npz.h"
 #include "tests/hand/synthetic_model.h"
+#include "tests/synth/shipped_hands.h"
 #include "tests/error_of.h"
 
 using bimart::test::error_of;
@@ -154,6 +155,21 @@ TEST_F(HandModelTest, ValidateNamesWhatIsWrong) {
   EXPECT_THAT(error_of([&] { save_hand_model(m, path("bad.npz")); }),
               HasSubstr("cannot save '" + path("bad.npz") + "'"));
   EXPECT_FALSE(fs::exists(path("bad.npz")));
+}
+
+// Each fingertip is on its own finger, and every finger and the palm has vertices: the
+// refinement moves a finger's vertices together by these (pen_fingers_through).
+TEST(VertexFingers, FingertipsAreOnTheirFingersAndEveryFingerHasVertices) {
+  for (const HandModel* m : test::shipped_hands()) {
+    const std::vector<int> f = vertex_fingers(*m);
+    ASSERT_EQ(static_cast<int>(f.size()), m->num_vertices());
+    // fingertips: thumb, index, middle, ring, pinky; fingers: 1 index, 2 middle, 3 pinky, 4 ring, 5 thumb
+    const std::array<int, 5> expected = {5, 1, 2, 4, 3};
+    for (int k = 0; k < 5; ++k) EXPECT_EQ(f[static_cast<size_t>(m->fingertips[static_cast<size_t>(k)])], expected[static_cast<size_t>(k)]);
+    std::array<int, 6> count{};
+    for (const int g : f) ++count[static_cast<size_t>(g)];
+    for (int g = 0; g < 6; ++g) EXPECT_GT(count[static_cast<size_t>(g)], 20) << "finger " << g;
+  }
 }
 
 }  // namespace
