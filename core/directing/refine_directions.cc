@@ -1,5 +1,7 @@
 #include "core/directing/refine_directions.h"
 
+#include <algorithm>
+
 #include <ATen/ATen.h>
 #include <fmt/format.h>
 
@@ -35,7 +37,16 @@ RefineDirections refine_directions(const HandConstraints& constraints, const std
   const std::int64_t N = states.size(0);
   RefineDirections r;
   for (const ContactConstraint& c : constraints.contacts) {
-    if (c.part != ContactPart::None) continue;
+    if (c.part != ContactPart::None) {  // the hold term keeps the hand on its part
+      auto& hold = r.hold[static_cast<std::size_t>(c.hand)];
+      if (hold.empty()) hold.assign(static_cast<std::size_t>(N), -1);
+      const ObjectPart part = c.part == ContactPart::Top      ? ObjectPart::Top
+                              : c.part == ContactPart::Bottom ? ObjectPart::Bottom
+                                                              : ObjectPart::Whole;
+      for (std::int64_t f = std::max<std::int64_t>(c.frames.first, 0); f <= std::min(c.frames.last, N - 1); ++f)
+        hold[static_cast<std::size_t>(f)] = static_cast<int>(part);
+      continue;
+    }
     auto& clear = r.clearance[static_cast<std::size_t>(c.hand)];
     if (clear.empty()) clear.assign(static_cast<std::size_t>(N), 0.0);
     const FrameRange span = c.with_ramps(N);

@@ -1012,13 +1012,22 @@ void refine_hand(HandData* d, const ObjectDistance& dist, const RefineOptions& o
 // Per hand and frame, the part it is held to (HandData::hold_part): in a held (turning)
 // frame, the starting hand nearer the object (its top part); the term only pulls a hand
 // from outside, so one that touches or is inside costs nothing. The top part wins over the
-// whole object for a hand chosen twice.
+// whole object for a hand chosen twice. A directed contact (RefineDirections::hold) holds
+// its hand to its part over its frames, whichever hand is nearer: the penetration planes
+// otherwise push a hand that should rest on a part off it.
 void assign_holds(const std::array<const HandModel*, 2>& models, const ObjectDistance& dist,
                   const std::vector<ObjectState>& states, const HandMotion& start, const HeldFrames& held,
                   const RefineOptions& o, const RefineDirections& directions, std::array<HandData, 2>* data) {
   const std::size_t N = states.size();
   for (HandData& d : *data) d.hold_part.assign(N, -1);
-  if (o.w_hold == 0 || (held.held.empty() && held.turning.empty())) return;
+  if (o.w_hold == 0) return;
+  const auto kept = [&](std::size_t t) { return !directions.kept.empty() && directions.kept[t]; };
+  for (int h = 0; h < 2; ++h) {
+    const std::vector<int>& asked = directions.hold[static_cast<std::size_t>(h)];
+    for (std::size_t t = 0; t < asked.size() && t < N; ++t)
+      if (asked[t] >= 0 && !kept(t)) (*data)[static_cast<std::size_t>(h)].hold_part[t] = asked[t];
+  }
+  if (held.held.empty() && held.turning.empty()) return;
   if ((!held.held.empty() && held.held.size() != N) || (!held.turning.empty() && held.turning.size() != N))
     throw Error("refinement: held frames need " + std::to_string(N) + " flags each, got " +
                 std::to_string(held.held.size()) + " and " + std::to_string(held.turning.size()));
@@ -1034,14 +1043,17 @@ void assign_holds(const std::array<const HandModel*, 2>& models, const ObjectDis
   for (std::size_t t = 0; t < N; ++t)
     for (const auto& [part, flags] : passes) {
       if (flags->empty() || !(*flags)[t]) continue;
-      if (!directions.kept.empty() && directions.kept[t]) continue;
+      if (kept(t)) continue;
       double sd[2];
       for (int h = 0; h < 2; ++h) {
         const Eigen::Map<const Points3> v(V[h][static_cast<int64_t>(t)].data_ptr<double>(), Vn, 3);
         sd[h] = may(part, t, h) ? dist.max_signed_distance(states[t], v, part) : -std::numeric_limits<double>::infinity();
       }
       if (!may(part, t, 0) && !may(part, t, 1)) continue;
-      int& p = (*data)[sd[0] >= sd[1] ? 0 : 1].hold_part[t];
+      const int h = sd[0] >= sd[1] ? 0 : 1;
+      const std::vector<int>& asked = directions.hold[static_cast<std::size_t>(h)];
+      if (!asked.empty() && asked[t] >= 0) continue;  // held to its directed part already
+      int& p = (*data)[static_cast<std::size_t>(h)].hold_part[t];
       if (part == ObjectPart::Top || p < 0) p = static_cast<int>(part);
     }
 }
@@ -1053,6 +1065,10 @@ void apply_directions(const RefineDirections& r, int h, HandData* d) {
   if (!clear.empty() && clear.size() != N)
     throw Error(fmt::format("refinement: {} clearances for {} frames", clear.size(), N));
   if (!r.kept.empty() && r.kept.size() != N) throw Error(fmt::format("refinement: {} kept flags for {} frames", r.kept.size(), N));
+  const auto& hold = r.hold[static_cast<size_t>(h)];
+  if (!hold.empty() && hold.size() != N) throw Error(fmt::format("refinement: {} held parts for {} frames", hold.size(), N));
+  for (const int p : hold)
+    if (p < -1 || p > static_cast<int>(ObjectPart::Whole)) throw Error(fmt::format("refinement: a held part {} (-1..2)", p));
   for (const at::Tensor* m : {&r.may_hold, &r.may_hold_top})
     if (m->defined() && (m->dim() != 2 || m->size(0) != d->N || m->size(1) != 2))
       throw Error("refinement: the hands that may hold must be [" + std::to_string(N) + ", 2], got " + c10::str(m->sizes()));

@@ -167,10 +167,13 @@ struct RefineDirections {
   std::array<std::vector<double>, 2> clearance;  // N per hand, or empty: none
   std::vector<bool> kept;                        // N, or empty: none
   at::Tensor may_hold, may_hold_top;
+  // N per hand, or empty: the part (ObjectPart) a directed contact asks the hand to touch in
+  // each frame, -1 none; the hold term (w_hold) keeps it there, held frame or not.
+  std::array<std::vector<int>, 2> hold;
   double w_pin = 1e4;  // per pinned frame, not averaged: a pin outweighs the frame's other terms
   bool empty() const {
     return pins[0].empty() && pins[1].empty() && clearance[0].empty() && clearance[1].empty() && kept.empty() &&
-           !may_hold.defined() && !may_hold_top.defined();
+           !may_hold.defined() && !may_hold_top.defined() && hold[0].empty() && hold[1].empty();
   }
 };
 

@@ -13,6 +13,7 @@
 #include "core/directing/hand_constraints.h"
 #include "core/directing/hand_pins.h"
 #include "core/directing/kept_sample.h"
+#include "core/directing/refine_directions.h"
 #include "core/features/hand_features.h"
 #include "core/geometry/rotation.h"
 #include "core/hand/keypoints.h"
@@ -155,6 +156,21 @@ TEST(HandConstraints, MistakesNameTheFileAndLine) {
   EXPECT_THAT(test::error_of([&] { read_hand_constraints(none, trajectory_of(), true); }), HasSubstr("no `hands:` block"));
   EXPECT_EQ(parse_hand_constraints("{right: [{frame: 3, part: bottom}]}", "param", "", trajectory_of()).contacts.at(0).part,
             ContactPart::Bottom);
+}
+
+// The refinement holds a hand to the part a constraint asks for over its frames
+// (RefineDirections::hold: ObjectPart, -1 none); `none` is a clearance, not a hold.
+TEST(RefineDirections, PartsAreHeldOverTheirFrames) {
+  const HandConstraints c = parse_hand_constraints(
+      "{left: [{frames: [2, 4], part: bottom}], right: [{frames: [1, 2], part: any}, {frames: [7, 8], part: none}]}",
+      "param", "", trajectory_of(10));
+  const RefineDirections r = refine_directions(c, test::shipped_hands(), at::zeros({10, 7}));
+  const int B = static_cast<int>(ObjectPart::Bottom), W = static_cast<int>(ObjectPart::Whole);
+  EXPECT_EQ(r.hold[0], (std::vector<int>{-1, -1, B, B, B, -1, -1, -1, -1, -1}));
+  EXPECT_EQ(r.hold[1], (std::vector<int>{-1, W, W, -1, -1, -1, -1, -1, -1, -1}));
+  ASSERT_EQ(r.clearance[1].size(), 10u);
+  EXPECT_GT(r.clearance[1][7], 0.0);
+  EXPECT_TRUE(r.clearance[0].empty());
 }
 
 // 3 frames; per frame 1024 object points, the first 512 on the top part.

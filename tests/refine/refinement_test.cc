@@ -339,6 +339,40 @@ TEST(Refinement, TheHoldTermPutsOneHandOnTheObjectWhereItMustBeHeld) {
   EXPECT_THROW(refine_hands(models, distance, c.states, c.pushed, c.fit, o, nullptr, HeldFrames{{true}, {}}), Error);
 }
 
+// A directed contact (`part:` in a hands file, RefineDirections::hold): hands 3 cm above the
+// slab, nothing held by the object's motion; the left hand asked onto the slab (the bottom
+// part) in frames 1-2 comes onto it there, the right stays up.
+TEST(Refinement, ADirectedContactHoldsItsHandOnItsPart) {
+  const auto& models = test::shipped_hands();
+  const ArticulatedObject object = slab();
+  const ObjectDistance distance(object);
+  const int N = 4;
+  const PushedHands c = pushed_into_the_slab(object, N, -0.03f);
+  RefineOptions o;
+  o.w_proj = 0;
+  o.w_hold = 1e5;
+  RefineDirections asked;
+  asked.hold[0] = {-1, static_cast<int>(ObjectPart::Bottom), static_cast<int>(ObjectPart::Bottom), -1};
+  const auto deepest = [&](const HandMotion& m, int h, int t) {
+    const at::Tensor v = m.vertices[h][t].to(at::kDouble).contiguous();
+    return distance.max_signed_distance(ObjectState{}, Eigen::Map<const Points3>(v.data_ptr<double>(), v.size(0), 3));
+  };
+  RefineReport report;
+  const HandMotion out = refine_hands(models, distance, c.states, c.pushed, c.fit, o, &report, HeldFrames{}, asked);
+  std::printf("%s", format_refine_report(report).c_str());
+  EXPECT_EQ(report.hands[0].held_frames, 2);
+  EXPECT_EQ(report.hands[1].held_frames, 0);
+  for (int t = 1; t <= 2; ++t) {
+    EXPECT_GT(deepest(out, 0, t), -0.005) << "frame " << t << ": the left hand touches (Con's test)";
+    EXPECT_LE(deepest(out, 0, t), o.pen_tolerance) << "frame " << t;
+  }
+  for (int t = 0; t < N; ++t) EXPECT_LT(deepest(out, 1, t), -0.02) << "frame " << t << ": the right hand stays up";
+  asked.hold[0] = {-1, 3, -1, -1};
+  EXPECT_THROW(refine_hands(models, distance, c.states, c.pushed, c.fit, o, nullptr, HeldFrames{}, asked), Error);
+  asked.hold[0] = {-1, 0};
+  EXPECT_THROW(refine_hands(models, distance, c.states, c.pushed, c.fit, o, nullptr, HeldFrames{}, asked), Error);
+}
+
 TEST(Refinement, AJitterySequenceComesOutSmoother) {
   const auto& models = test::shipped_hands();
   const ArticulatedObject object = slab();
