@@ -642,7 +642,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     if (o.pen_fingers_through && !exit.isZero())
       for (const auto& [i, q] : near)
         if (q.signed_distance > 0) finger_inside[static_cast<size_t>(d->finger_of[static_cast<size_t>(i)])] = true;
-    std::vector<bool> has_wall(static_cast<size_t>(V), false);
+    std::vector<bool> has_wall(cavity.empty() ? 0 : static_cast<size_t>(V), false);  // most frames: none
     for (const auto& [i, wall] : cavity) {
       has_wall[static_cast<size_t>(i)] = true;
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
@@ -653,7 +653,7 @@ Evaluation evaluate(HandData* d, const LbsSubset& all, const ObjectDistance& dis
     for (const auto& [i, q] : near) {
       // A cavity vertex's plane is beyond the wall: its nearest (the wall's inner face,
       // facing the cavity) would hold it back there.
-      if (has_wall[static_cast<size_t>(i)]) continue;
+      if (!has_wall.empty() && has_wall[static_cast<size_t>(i)]) continue;
       f->pen_rows.push_back(row_for(all.vertex_ids[static_cast<size_t>(i)]));
       const bool turn = !exit.isZero() && q.normal.dot(exit) < 0;
       const Eigen::Vector3d p = v.row(i).transpose();
